@@ -259,7 +259,7 @@ TEST(RobustnessEndToEnd, ParkedVehicleDoesNotWanderInEitherEstimator) {
         if (e.x.t >= t0 && e.x.t <= t1) wander = std::max(wander, (e.x.p_wb - PositionAt(*states, t0)).norm());
       }
       const double err = MaxHorizontalError(out, *states, t0, t1);
-      std::printf("%s wheels=%d zm=%s: drift over 60 s parked %.5f m (largest excursion %.5f m), error vs truth %.4f m, "
+      std::printf("%s wheels=%d (zero-motion factors %s): drift over 60 s parked %.5f m (largest excursion %.5f m), error vs truth %.4f m, "
                   "zero_velocity %s\n",
                   name, wheels, (*stats).value("zero_motion_factors", nlohmann::json(0)).dump().c_str(), drift.norm(), wander, err, (*stats)["zero_velocity"].dump().c_str());
       EXPECT_LT(drift.norm(), 0.005) << name;

@@ -588,6 +588,7 @@ void ReadSmoother(MapReader m, SmootherOptions* o) {
   m.Choice("linear_solver", solvers, &solver);
   if (solver >= 0) o->linear_solver = solvers[solver];
   m.Integer("max_iterations", &o->max_iterations, 1);
+  m.Number("function_tolerance", &o->function_tolerance, kNoUnit, Within(1e-12, 0.1));
   m.Integer("num_threads", &o->num_threads, 1);
   m.Number("gnss_loss_scale", &o->gnss_loss_scale, kNoUnit, Positive());
   m.Number("bias_reintegrate_threshold", &o->bias_reintegrate_threshold, kNoUnit, NonNegative());
@@ -658,6 +659,7 @@ void ReadSimulate(MapReader m, SimOptions* o) {
   if (const YAML::Node* n = m.Find("origin")) o->origin = *ReadOrigin(m.ctx(), *n, m.Path("origin"), false);
   m.Number("initial_heading_deg", &o->initial_yaw, kCompassDeg, Within(-360.0, 360.0));
   if (const YAML::Node* n = m.Find("segments")) o->segments = ReadSegments(m.ctx(), *n, m.Path("segments"));
+  m.Integer("repeat", &o->repeat, 1, 100000);
   m.Number("imu_rate_hz", &o->imu_rate, kNoUnit, Positive());
   m.Number("gnss_rate_hz", &o->gnss_rate, kNoUnit, Positive());
   m.Number("wheel_rate_hz", &o->wheel_rate, kNoUnit, Positive());
@@ -897,6 +899,7 @@ std::string OptionsToYaml(const Options& o) {
   w.Key("min_keyframe_interval_s", FormatNumber(sm.min_keyframe_interval));
   w.Key("linear_solver", sm.linear_solver);
   w.Key("max_iterations", std::to_string(sm.max_iterations));
+  w.Key("function_tolerance", FormatNumber(sm.function_tolerance));
   w.Key("num_threads", std::to_string(sm.num_threads));
   w.Key("gnss_loss_scale", FormatNumber(sm.gnss_loss_scale));
   w.Key("bias_reintegrate_threshold", FormatNumber(sm.bias_reintegrate_threshold));
@@ -931,6 +934,7 @@ std::string OptionsToYaml(const Options& o) {
             "}");
     }
   }
+  w.Key("repeat", std::to_string(sim.repeat));
   w.Key("imu_rate_hz", FormatNumber(sim.imu_rate));
   w.Key("gnss_rate_hz", FormatNumber(sim.gnss_rate));
   w.Key("wheel_rate_hz", FormatNumber(sim.wheel_rate));

@@ -108,6 +108,7 @@ struct SmootherOptions {
   double min_keyframe_interval = 0.5;  // smoother.min_keyframe_interval_s: faster GNSS is decimated
   std::string linear_solver = "dense_schur";  // smoother.linear_solver: dense_schur | sparse_normal_cholesky
   int max_iterations = 10;          // smoother.max_iterations
+  double function_tolerance = 1e-3;  // smoother.function_tolerance: stop when |Δcost|/cost falls below
   int num_threads = 1;              // smoother.num_threads
   double gnss_loss_scale = 3.0;     // smoother.gnss_loss_scale: Cauchy loss scale on whitened residuals
   double bias_reintegrate_threshold = 1e-3;  // smoother.bias_reintegrate_threshold (norm of δb)
@@ -144,6 +145,7 @@ struct SimOptions {
   GeodeticPoint origin{31.5, 120.4, 10.0};
   double initial_yaw = 0.0;   // rad ENU (yaml: initial_heading_deg, compass)
   std::vector<SimSegment> segments;
+  unsigned repeat = 1;        // the segment list is driven this many times in a row (long benchmark drives)
   double imu_rate = 100.0, gnss_rate = 1.0, wheel_rate = 10.0;
   // True sensor errors.
   double gyro_noise_density = 0.5 * kDegToRad / 60.0, acc_noise_density = 0.05 / 60.0;

@@ -31,6 +31,35 @@ struct Kinematics {
 Kinematics ImuStep(const Kinematics& x, const Vec3& omega, const Vec3& acc, const Vec3& g_w, double dt,
                    ImuStepJacobians* J = nullptr);
 
+// Products with the step Jacobians that skip their zero and identity blocks (as ImuStep fills them): the
+// ESKF's covariance propagation at IMU rate is made of these. X has the rows δp, δv, δθ; Y has the rows
+// δbg, δba, δg. MulA(J, X) = A·X; MulBG(J, Y, with_gravity) = [B G]·Y (G's part only if with_gravity).
+template <int N>
+Eigen::Matrix<double, 9, N> MulA(const ImuStepJacobians& J, const Eigen::Matrix<double, 9, N>& X) {
+  const double dt = J.A(0, 3);
+  const auto Xt = X.template middleRows<3>(6);
+  Eigen::Matrix<double, 9, N> out;
+  out.template middleRows<3>(0) = X.template middleRows<3>(0) + dt * X.template middleRows<3>(3) +
+                                  J.A.template block<3, 3>(0, 6).lazyProduct(Xt);
+  out.template middleRows<3>(3) = X.template middleRows<3>(3) + J.A.template block<3, 3>(3, 6).lazyProduct(Xt);
+  out.template middleRows<3>(6) = J.A.template block<3, 3>(6, 6).lazyProduct(Xt);
+  return out;
+}
+
+template <int N>
+Eigen::Matrix<double, 9, N> MulBG(const ImuStepJacobians& J, const Eigen::Matrix<double, 9, N>& Y, bool with_gravity) {
+  const auto Yba = Y.template middleRows<3>(3);
+  Eigen::Matrix<double, 9, N> out;
+  out.template middleRows<3>(0) = J.B.template block<3, 3>(0, 3).lazyProduct(Yba);
+  out.template middleRows<3>(3) = J.B.template block<3, 3>(3, 3).lazyProduct(Yba);
+  out.template middleRows<3>(6) = J.B.template block<3, 3>(6, 0).lazyProduct(Y.template middleRows<3>(0));
+  if (with_gravity) {
+    out.template middleRows<3>(0) += J.G(0, 0) * Y.template middleRows<3>(6);
+    out.template middleRows<3>(3) += J.G(3, 0) * Y.template middleRows<3>(6);
+  }
+  return out;
+}
+
 // The rate and specific force to hold between two consecutive samples: their mean. Second-order accurate
 // for sampled (not interval-averaged) IMU data, where holding the first sample lags the attitude by half a
 // step of the rate change. Time stamp: the later sample's.

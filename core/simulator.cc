@@ -145,16 +145,18 @@ TruthTrajectory::TruthTrajectory(const SimOptions& sim)
     : start_time_(sim.start_time), initial_yaw_(sim.initial_yaw), frame_(CheckedOrigin(sim.origin)) {
   Require(std::isfinite(sim.start_time) && std::isfinite(sim.initial_yaw), "start_time, initial_yaw must be finite");
   double t0 = 0.0;
-  for (const SimSegment& seg : sim.segments) {
-    Require(FiniteNonNegative(seg.duration) && std::isfinite(seg.accel) && std::isfinite(seg.yaw_rate) &&
-                std::isfinite(seg.grade) && std::abs(seg.grade) < 0.5 * kPi,
-            "segments need finite duration >= 0, accel, yaw_rate and |grade| < 90 deg");
-    if (seg.duration == 0.0) continue;  // nothing happens in it
-    const double ramp = std::min(kTransitionTime, seg.duration);
-    accel_.Add(t0, ramp, seg.accel);
-    yaw_rate_.Add(t0, ramp, seg.yaw_rate);
-    grade_.Add(t0, seg.duration, seg.grade);
-    t0 += seg.duration;
+  for (unsigned lap = 0; lap < sim.repeat; ++lap) {
+    for (const SimSegment& seg : sim.segments) {
+      Require(FiniteNonNegative(seg.duration) && std::isfinite(seg.accel) && std::isfinite(seg.yaw_rate) &&
+                  std::isfinite(seg.grade) && std::abs(seg.grade) < 0.5 * kPi,
+              "segments need finite duration >= 0, accel, yaw_rate and |grade| < 90 deg");
+      if (seg.duration == 0.0) continue;  // nothing happens in it
+      const double ramp = std::min(kTransitionTime, seg.duration);
+      accel_.Add(t0, ramp, seg.accel);
+      yaw_rate_.Add(t0, ramp, seg.yaw_rate);
+      grade_.Add(t0, seg.duration, seg.grade);
+      t0 += seg.duration;
+    }
   }
   Require(t0 > 0.0, "segments must have a positive total duration");
   duration_ = t0;

@@ -65,11 +65,12 @@ bool StandstillDetector::ImuQuiet() const {
 bool StandstillDetector::WheelsPresent() const { return !wheels_.empty(); }
 
 bool StandstillDetector::Standing() const {
-  if (!options_.enabled || !ImuQuiet()) return false;
+  if (!options_.enabled) return false;
+  // Wheels first: they are the cheap test, and while driving they settle it.
   for (const WheelMeasurement& w : wheels_) {
     if (!w.standstill) return false;
   }
-  return true;
+  return ImuQuiet();
 }
 
 }  // namespace gins

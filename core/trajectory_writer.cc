@@ -3,25 +3,24 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <charconv>
 #include <cstring>
 #include <stdexcept>
+
+#include "core/number_format.h"
 
 namespace gins {
 namespace {
 
-// Builds one output line with std::to_chars: several times faster than printf, which dominated the
-// ESKF's run time at IMU rate.
+// Builds one output line with the fast formatters of core/number_format.h: printf, then std::to_chars,
+// dominated the ESKF's run time at IMU rate.
 class Line {
  public:
   Line& Fixed(double v, int precision) {
-    const auto r = std::to_chars(pos_, end_, v, std::chars_format::fixed, precision);
-    pos_ = r.ec == std::errc() ? r.ptr : pos_;
+    pos_ = FormatFixed(pos_, end_, v, precision);
     return *this;
   }
   Line& Sci(double v, int precision) {
-    const auto r = std::to_chars(pos_, end_, v, std::chars_format::scientific, precision);
-    pos_ = r.ec == std::errc() ? r.ptr : pos_;
+    pos_ = FormatScientific(pos_, end_, v, precision);
     return *this;
   }
   Line& Char(char c) {

@@ -23,6 +23,7 @@ double GateFor(double probability, int dof) {
 constexpr double kGapAccSigma = 2.0;                // m/s²
 constexpr double kGapRateSigma = 10.0 * kDegToRad;  // rad/s
 constexpr size_t kMaxListed = 100;                  // gaps and resets listed in the summary
+constexpr double kZeroRateGateProbability = 0.9999;  // the gyro-reads-its-bias update at standstills
 // Watchdog re-initialisation: position 1-σ added to the fix's, velocity 1-σ, and the longest fix interval
 // a velocity is differenced over.
 constexpr double kResetPosSigma = 1.0;  // m
@@ -36,6 +37,9 @@ Eskf::Eskf(const Options& options, StateCallback on_state) : options_(options), 
   gate_gnss_ = GateFor(options_.gnss.gate_probability, 3);
   gate_heading_ = GateFor(options_.gnss.gate_probability, 1);
   gate_wheel_ = GateFor(options_.wheel.gate_probability, 1);
+  gate_nhc_ = GateFor(options_.wheel.gate_probability, 2);
+  gate_zupt_ = GateFor(options_.wheel.gate_probability, 3);
+  gate_zero_rate_ = GateFor(kZeroRateGateProbability, 3);
 }
 
 void Eskf::Initialize(const InitResult& init) {
@@ -78,18 +82,19 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   x_.t = t;
   ++imu_steps_;
 
-  // F = [[A, C], [0, I]] with the kinematic block a = (δp, δv, δθ) and b = (δbg, δba, δg, δs):
-  // F P Fᵀ costs a few 9×10 products instead of 19×19 ones.
+  // F = [[A, C], [0, I]] with the kinematic block a = (δp, δv, δθ) and b = (δbg, δba, δg, δs), C = [B G 0]:
+  // P'aa = A·Paa·Aᵀ + A·Pab·Cᵀ + C·Pba·Aᵀ + C·Pbb·Cᵀ = (A·M1ᵀ + C·Mᵀ)ᵀ with M1 = A·Paa + C·Pba and
+  // M = P'ab = A·Pab + C·Pbb. The products skip A's and C's zero and identity blocks (MulA, MulBG).
   using Mat9x10 = Eigen::Matrix<double, 9, 10>;
-  Mat9x10 C = Mat9x10::Zero();
-  C.leftCols<6>() = J.B;
-  if (options_.eskf.estimate_gravity) C.block<9, 3>(0, 6) = J.G;
+  const bool with_g = options_.eskf.estimate_gravity;
   const Mat9 Paa = P_.topLeftCorner<9, 9>();
   const Mat9x10 Pab = P_.topRightCorner<9, 10>();
-  const Eigen::Matrix<double, 10, 10> Pbb = P_.bottomRightCorner<10, 10>();
-  const Mat9x10 APab = J.A * Pab;
-  const Mat9x10 M = APab + C * Pbb;
-  P_.topLeftCorner<9, 9>() = J.A * Paa * J.A.transpose() + M * C.transpose() + C * APab.transpose();
+  const Mat9 Pba9 = P_.block<9, 9>(9, 0);  // rows δbg, δba, δg of Pba (C has no δs column)
+  const Mat9x10 Pbb9 = P_.block<9, 10>(9, 9);
+  const Mat9x10 M = MulA<10>(J, Pab) + MulBG<10>(J, Pbb9, with_g);
+  const Mat9 M1 = MulA<9>(J, Paa) + MulBG<9>(J, Pba9, with_g);
+  const Mat9 MtC = M.leftCols<9>().transpose();  // rows δbg, δba, δg of Mᵀ
+  P_.topLeftCorner<9, 9>() = (MulA<9>(J, Mat9(M1.transpose())) + MulBG<9>(J, MtC, with_g)).transpose();
   P_.topRightCorner<9, 10>() = M;
   P_.bottomLeftCorner<10, 9>() = M.transpose();
 
@@ -101,7 +106,8 @@ void Eskf::Propagate(double t, const ImuSample* held) {
                       Vec3::Constant(kGapAccSigma * kGapAccSigma))
                          .finished();
   }
-  P_.topLeftCorner<9, 9>() += J.B * Qn * J.B.transpose();
+  const Eigen::Matrix<double, 9, 6> BQ = J.B.lazyProduct(Qn);
+  P_.topLeftCorner<9, 9>() += BQ.lazyProduct(J.B.transpose());
   const double qbg = options_.imu.gyro_bias_rw * options_.imu.gyro_bias_rw * dt;
   const double qba = options_.imu.acc_bias_rw * options_.imu.acc_bias_rw * dt;
   P_.block<3, 3>(nav::kBg, nav::kBg).diagonal().array() += qbg;
@@ -131,8 +137,8 @@ void Eskf::AddImu(const ImuSample& imu) {
 template <int M>
 bool Eskf::Update(const Eigen::Matrix<double, M, 1>& r, const Eigen::Matrix<double, M, eskf::kDim>& H,
                   const Eigen::Matrix<double, M, M>& R, double gate, MeasurementCounts* counts, double t) {
-  const Eigen::Matrix<double, eskf::kDim, M> PHt = P_ * H.transpose();
-  const Eigen::Matrix<double, M, M> S = H * PHt + R;
+  const Eigen::Matrix<double, eskf::kDim, M> PHt = P_.lazyProduct(H.transpose());
+  const Eigen::Matrix<double, M, M> S = H.lazyProduct(PHt) + R;
   const Eigen::LLT<Eigen::Matrix<double, M, M>> llt(S);
   if (llt.info() != Eigen::Success || !r.allFinite()) {
     counts->Reject("numerical", t);
@@ -145,9 +151,11 @@ bool Eskf::Update(const Eigen::Matrix<double, M, 1>& r, const Eigen::Matrix<doub
   }
   const Eigen::Matrix<double, eskf::kDim, M> K = llt.solve(PHt.transpose()).transpose();
   const VecP dx = -K * r;
-  // Joseph form keeps P symmetric and positive for any gain.
-  MatP IKH = MatP::Identity() - K * H;
-  P_ = IKH * P_ * IKH.transpose() + K * R * K.transpose();
+  // Joseph form, (I−KH)P(I−KH)ᵀ + KRKᵀ, which keeps P symmetric and positive for any gain, expanded as
+  // P − K(PHᵀ)ᵀ − PHᵀKᵀ + KSKᵀ: rank-M products instead of three 19×19 ones.
+  const Eigen::Matrix<double, eskf::kDim, M> KS = K.lazyProduct(S);
+  const MatP KHP = K.lazyProduct(PHt.transpose());
+  P_ += KS.lazyProduct(K.transpose()) - KHP - KHP.transpose();
   Inject(dx);
   ++counts->used;
   return true;
@@ -159,10 +167,13 @@ void Eskf::Inject(const VecP& dx) {
   scale_ += dx[eskf::kS];
   // Reset: the error is now zero about the corrected rotation; project the covariance accordingly
   // (right perturbation: ∂δθ⁺/∂δθ = I − ½[δθ]×).
-  MatP Jr = MatP::Identity();
-  Jr.block<3, 3>(nav::kTheta, nav::kTheta) = Mat3::Identity() - 0.5 * Hat<double>(Vec3(dx.segment<3>(nav::kTheta)));
-  P_ = Jr * P_ * Jr.transpose();
-  P_ = 0.5 * (P_ + P_.transpose());
+  // Jr is the identity but for its δθ block, so only the δθ rows and columns of P change.
+  const Mat3 Jt = Mat3::Identity() - 0.5 * Hat<double>(Vec3(dx.segment<3>(nav::kTheta)));
+  const Eigen::Matrix<double, 3, eskf::kDim> rows = Jt.lazyProduct(P_.middleRows<3>(nav::kTheta));
+  P_.middleRows<3>(nav::kTheta) = rows;
+  const Eigen::Matrix<double, eskf::kDim, 3> cols = P_.middleCols<3>(nav::kTheta).lazyProduct(Jt.transpose());
+  P_.middleCols<3>(nav::kTheta) = cols;
+  P_ = 0.5 * (P_ + P_.transpose()).eval();
 }
 
 void Eskf::AddGnss(const GnssMeasurement& m) {
@@ -262,7 +273,7 @@ void Eskf::AddWheel(const WheelMeasurement& m) {
       Hn.block<2, 3>(0, nav::kV) = H6.leftCols<3>();
       Hn.block<2, 3>(0, nav::kTheta) = H6.rightCols<3>();
       const double s2 = options_.wheel.nhc_sigma * options_.wheel.nhc_sigma;
-      Update<2>(rn, Hn, Eigen::Matrix2d::Identity() * s2, GateFor(options_.wheel.gate_probability, 2), &wheel_counts_,
+      Update<2>(rn, Hn, Eigen::Matrix2d::Identity() * s2, gate_nhc_, &wheel_counts_,
                 m.t);
     }
   }
@@ -287,13 +298,13 @@ void Eskf::AddStandstill(const StandstillMeasurement& m) {
   Eigen::Matrix<double, 3, eskf::kDim> H = Eigen::Matrix<double, 3, eskf::kDim>::Zero();
   H.block<3, 3>(0, nav::kV).setIdentity();
   const double sv = options_.standstill.velocity_sigma;
-  Update<3>(r, H, Mat3::Identity() * sv * sv, GateFor(options_.wheel.gate_probability, 3), &zupt_counts_, m.t);
+  Update<3>(r, H, Mat3::Identity() * sv * sv, gate_zupt_, &zupt_counts_, m.t);
   if (rate_usable) {
     Eigen::Matrix<double, 3, 1> rg = x_.bg - mean_gyro;
     Eigen::Matrix<double, 3, eskf::kDim> Hg = Eigen::Matrix<double, 3, eskf::kDim>::Zero();
     Hg.block<3, 3>(0, nav::kBg).setIdentity();
     const double sigma = 2.0 * options_.imu.gyro_noise_density / std::sqrt(T);
-    Update<3>(rg, Hg, Mat3::Identity() * sigma * sigma, GateFor(0.9999, 3), &zupt_counts_, m.t);
+    Update<3>(rg, Hg, Mat3::Identity() * sigma * sigma, gate_zero_rate_, &zupt_counts_, m.t);
   }
 }
 

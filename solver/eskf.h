@@ -84,7 +84,9 @@ class Eskf : public Estimator {
   int gyro_count_ = 0;
   double gyro_sum_start_ = 0.0;
 
-  double gate_gnss_ = 0.0, gate_heading_ = 0.0, gate_wheel_ = 0.0;
+  // χ² gates, computed once (the quantile is an iterative inversion).
+  double gate_gnss_ = 0.0, gate_heading_ = 0.0, gate_wheel_ = 0.0, gate_nhc_ = 0.0, gate_zupt_ = 0.0,
+         gate_zero_rate_ = 0.0;
   uint64_t imu_steps_ = 0, imu_gaps_ = 0;
   std::vector<std::pair<double, double>> gap_times_;  // first few IMU gaps: [last sample, next sample]
   MeasurementCounts gnss_counts_, heading_counts_, wheel_counts_, zupt_counts_;

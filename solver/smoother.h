@@ -73,6 +73,8 @@ class Smoother : public Estimator {
   void AttachStandstill(Keyframe* kf);
   void WatchGnss(double t, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
+  // One Ceres solve of the window with the configured options; false if the solution is not usable.
+  bool Solve();
   void SolveAndSlide();
   void CheckGnssResiduals();
   void CheckStandstillResiduals();

@@ -59,6 +59,18 @@ TEST_F(ImuKernelTest, ConstantMotionIsExactForPositionAndVelocity) {
   EXPECT_LT((y.p - (x.p + x.v * 0.5 + 0.125 * a_w)).norm(), 1e-12);
 }
 
+// The structured products equal the dense ones: they may skip only blocks ImuStep leaves zero or identity.
+TEST_F(ImuKernelTest, StructuredProductsEqualDenseOnes) {
+  ImuStepJacobians J;
+  ImuStep(x, omega, acc, g, dt, &J);
+  const Eigen::Matrix<double, 9, 7> X = Eigen::Matrix<double, 9, 7>::Random();
+  EXPECT_LT((MulA<7>(J, X) - J.A * X).cwiseAbs().maxCoeff(), 1e-14);
+  const Eigen::Matrix<double, 9, 7> Y = Eigen::Matrix<double, 9, 7>::Random();
+  const Eigen::Matrix<double, 9, 7> with_g = J.B * Y.topRows<6>() + J.G * Y.bottomRows<3>();
+  EXPECT_LT((MulBG<7>(J, Y, true) - with_g).cwiseAbs().maxCoeff(), 1e-14);
+  EXPECT_LT((MulBG<7>(J, Y, false) - J.B * Y.topRows<6>()).cwiseAbs().maxCoeff(), 1e-14);
+}
+
 TEST(ImuDiscreteNoise, ScalesWithRate) {
   const Mat6 Q = ImuDiscreteNoise(0.01, 0.1, 0.01);
   EXPECT_NEAR(Q(0, 0), 0.01 * 0.01 / 0.01, 1e-15);

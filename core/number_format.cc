@@ -1,0 +1,121 @@
+#include "core/number_format.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+
+namespace gins {
+namespace {
+
+constexpr int kMaxPrecision = 9;
+// Exact powers of ten (10^22 is the largest one a double holds exactly).
+constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                             1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+constexpr int kMaxPow10 = 22;
+constexpr double kMaxInteger = 1.0e18;  // the integer part fits a uint64_t
+
+// x ≥ 0 (below 2^62) rounded to the nearest integer, ties to even as to_chars does; inline, unlike rint.
+uint64_t RoundHalfEven(double x) {
+  uint64_t r = static_cast<uint64_t>(x + 0.5);
+  if (static_cast<double>(r) - x == 0.5 && (r & 1) != 0) --r;
+  return r;
+}
+
+char* Fallback(char* first, char* last, double v, std::chars_format format, int precision) {
+  const auto r = std::to_chars(first, last, v, format, precision);
+  return r.ec == std::errc() ? r.ptr : first;
+}
+
+// Digits of n, at least `min_digits` of them (zero-padded), into [first, last).
+// "00" "01" ... "99": two digits per division halves the dependent chain of divisions.
+constexpr char kDigitPairs[] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839404142434445464748495051525354"
+    "555657585960616263646566676869707172737475767778798081828384858687888990919293949596979899";
+
+char* WriteDigits(char* first, char* last, uint64_t n, int min_digits) {
+  int k = 1;
+  for (uint64_t ten_k = 10; k < 19 && n >= ten_k; ten_k *= 10) ++k;
+  if (k == 19 && n >= 10000000000000000000ULL) k = 20;
+  if (k < min_digits) k = min_digits;
+  if (last - first < k) return nullptr;
+  char* p = first + k;
+  while (n >= 100) {
+    const uint64_t pair = n % 100;
+    n /= 100;
+    *--p = kDigitPairs[2 * pair + 1];
+    *--p = kDigitPairs[2 * pair];
+  }
+  if (n >= 10) {
+    *--p = kDigitPairs[2 * n + 1];
+    *--p = kDigitPairs[2 * n];
+  } else {
+    *--p = static_cast<char>('0' + n);
+  }
+  while (p > first) *--p = '0';
+  return first + k;
+}
+
+// "-"? ip "." fp (fp zero-padded to `precision` digits; no point when precision is 0). nullptr if too short.
+char* WriteDecimal(char* p, char* last, bool negative, uint64_t ip, uint64_t fp, int precision) {
+  if (negative) {
+    if (p == last) return nullptr;
+    *p++ = '-';
+  }
+  p = WriteDigits(p, last, ip, 1);
+  if (p == nullptr || precision == 0) return p;
+  if (p == last) return nullptr;
+  *p++ = '.';
+  return WriteDigits(p, last, fp, precision);
+}
+
+}  // namespace
+
+char* FormatFixed(char* first, char* last, double v, int precision) {
+  if (precision < 0 || precision > kMaxPrecision || !std::isfinite(v) || !(std::abs(v) < kMaxInteger)) {
+    return Fallback(first, last, v, std::chars_format::fixed, precision);
+  }
+  // Integer and fraction apart (both exact), so only the fraction is scaled: a timestamp's 16 digits
+  // would lose the last ones in one product. Ties round to even, as to_chars does.
+  const double a = std::abs(v);
+  const double whole = std::floor(a);
+  const uint64_t unit = static_cast<uint64_t>(kPow10[precision]);
+  uint64_t ip = static_cast<uint64_t>(whole);
+  uint64_t fp = RoundHalfEven((a - whole) * kPow10[precision]);
+  if (fp >= unit) {  // the fraction rounded up to one
+    fp -= unit;
+    ++ip;
+  }
+  char* p = WriteDecimal(first, last, v < 0.0 && (ip != 0 || fp != 0), ip, fp, precision);
+  return p == nullptr ? first : p;
+}
+
+char* FormatScientific(char* first, char* last, double v, int precision) {
+  if (precision < 0 || precision > kMaxPrecision || !std::isfinite(v) || v == 0.0) {
+    return Fallback(first, last, v, std::chars_format::scientific, precision);
+  }
+  const double a = std::abs(v);
+  int e = static_cast<int>(std::floor(std::log10(a)));
+  // Mantissa digits: a / 10^e scaled by 10^precision, computed as one product or quotient of exact powers.
+  auto digits = [&](int exp10) -> long long {
+    const int shift = precision - exp10;  // a · 10^shift
+    if (shift >= 0 && shift <= kMaxPow10) return static_cast<long long>(RoundHalfEven(a * kPow10[shift]));
+    if (shift < 0 && shift >= -kMaxPow10) return static_cast<long long>(RoundHalfEven(a / kPow10[-shift]));
+    return -1;
+  };
+  long long n = digits(e);
+  const long long lo = static_cast<long long>(kPow10[precision]);
+  if (n >= 10 * lo) n = digits(++e);  // log10 below a power of ten, or rounding up to one (9.99995 -> 10.000)
+  if (n >= 0 && n < lo) n = digits(--e);
+  if (n < lo || n >= 10 * lo) return Fallback(first, last, v, std::chars_format::scientific, precision);
+  const uint64_t un = static_cast<uint64_t>(n), ulo = static_cast<uint64_t>(lo);
+  char* p = WriteDecimal(first, last, v < 0.0, un / ulo, un % ulo, precision);
+  if (p == nullptr) return first;
+  if (last - p < 4) return first;
+  *p++ = 'e';
+  *p++ = e < 0 ? '-' : '+';
+  p = WriteDigits(p, last, static_cast<uint64_t>(std::abs(e)), 2);
+  return p == nullptr ? first : p;
+}
+
+}  // namespace gins

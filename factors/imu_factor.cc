@@ -32,8 +32,84 @@ ImuFactor::ImuFactor(std::shared_ptr<const Preintegration> preint, const Vec3& g
 }
 
 ceres::CostFunction* ImuFactor::Create(std::shared_ptr<const Preintegration> preint, const Vec3& g_w) {
+  return new ImuCostFunction(std::move(preint), g_w);
+}
+
+ceres::CostFunction* ImuFactor::CreateAutoDiff(std::shared_ptr<const Preintegration> preint, const Vec3& g_w) {
   return new ceres::AutoDiffCostFunction<ImuFactor, 9, pose::kAmbient, 3, 6, pose::kAmbient, 3>(
       new ImuFactor(std::move(preint), g_w));
+}
+
+namespace {
+
+using Mat93 = Eigen::Matrix<double, 9, 3>;
+using Mat34 = Eigen::Matrix<double, 3, 4>;
+
+// Writes the whitened tangent Jacobian of a pose block (columns δp, δθ) as the ambient one, J_tan·M(q)
+// (see ImuCostFunction in the header): p columns unchanged, q columns J_θ·2·[w·I − [v]×, −v].
+void WritePoseJacobian(const Mat93& J_dp, const Mat93& J_dtheta, const Quat& q, double* out) {
+  Mat34 M;
+  M.leftCols<3>() = 2.0 * (q.w() * Mat3::Identity() - Hat<double>(q.vec()));
+  M.col(3) = -2.0 * q.vec();
+  Eigen::Map<Eigen::Matrix<double, 9, pose::kAmbient, Eigen::RowMajor>> J(out);
+  J.middleCols<3>(pose::kP) = J_dp;
+  J.middleCols<4>(pose::kQ) = J_dtheta * M;
+}
+
+}  // namespace
+
+bool ImuCostFunction::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
+  const double* pose_i = parameters[0];
+  const double* vel_i = parameters[1];
+  const double* bias_i = parameters[2];
+  const double* pose_j = parameters[3];
+  const double* vel_j = parameters[4];
+  ImuResidualTerms<double> t;
+  factor_.Terms(pose_i, vel_i, bias_i, pose_j, vel_j, &t);
+  const Mat9& S = factor_.sqrt_information();
+  Eigen::Map<Vec9> r_w(residuals);
+  r_w = S * t.r;
+  if (jacobians == nullptr) return true;
+
+  // Whitened Jacobians S·J, formed as Σ over the residual's three row blocks of (columns of S)·(row block
+  // of J): J's row blocks are 3×3 matrices, many of them zero.
+  const Preintegration& pi = factor_.preintegration();
+  const Mat93 S_p = S.middleCols<3>(preint::kP);
+  const Mat93 S_v = S.middleCols<3>(preint::kV);
+  const Mat93 S_theta = S.middleCols<3>(preint::kTheta);
+  const Eigen::Map<const Quat> q_i(pose_i + pose::kQ), q_j(pose_j + pose::kQ);
+  const Mat3 R_iw = q_i.conjugate().toRotationMatrix();  // R_iᵀ
+  const Vec3 r_theta = t.r.segment<3>(preint::kTheta);
+  const Mat93 S_p_R_iw = S_p * R_iw;
+  const Mat93 S_v_R_iw = S_v * R_iw;
+  const Mat93 S_theta_Jr_inv = S_theta * RightJacobianInverse(r_theta);
+
+  if (jacobians[0] != nullptr) {  // pose_i
+    const Mat3 R_ji = t.q_ij.conjugate().toRotationMatrix();
+    const Mat93 J_dtheta = S_p * Hat<double>(t.dp_i) + S_v * Hat<double>(t.dv_i) - S_theta_Jr_inv * R_ji;
+    WritePoseJacobian(-S_p_R_iw, J_dtheta, Quat(q_i), jacobians[0]);
+  }
+  if (jacobians[1] != nullptr) {  // vel_i
+    Eigen::Map<Eigen::Matrix<double, 9, 3, Eigen::RowMajor>> J(jacobians[1]);
+    J = -(pi.dt() * S_p_R_iw + S_v_R_iw);
+  }
+  if (jacobians[2] != nullptr) {  // bias_i (bg, ba)
+    const Mat96& J_b = pi.bias_jacobian();
+    Eigen::Map<Eigen::Matrix<double, 9, 6, Eigen::RowMajor>> J(jacobians[2]);
+    J = -(S_p * J_b.middleRows<3>(preint::kP) + S_v * J_b.middleRows<3>(preint::kV));
+    // ΔR_corr = ΔR·Exp(φ + ∂ΔR/∂bg·δ) ≈ ΔR_corr·Exp(Jr(φ)·∂ΔR/∂bg·δ), which moves r_θ by −Jr⁻¹·Eᵀ·(that).
+    const Mat3 E_T = t.q_err.conjugate().toRotationMatrix();
+    J.middleCols<3>(preint::kBg).noalias() -=
+        S_theta_Jr_inv * (E_T * RightJacobian(t.phi_bg) * J_b.block<3, 3>(preint::kTheta, preint::kBg));
+  }
+  if (jacobians[3] != nullptr) {  // pose_j
+    WritePoseJacobian(S_p_R_iw, S_theta_Jr_inv, Quat(q_j), jacobians[3]);
+  }
+  if (jacobians[4] != nullptr) {  // vel_j
+    Eigen::Map<Eigen::Matrix<double, 9, 3, Eigen::RowMajor>> J(jacobians[4]);
+    J = S_v_R_iw;
+  }
+  return true;
 }
 
 }  // namespace gins

@@ -40,13 +40,27 @@ void EvaluateLoop(benchmark::State& state, ceres::CostFunction* cost, std::vecto
   }
 }
 
-void BM_ImuFactor(benchmark::State& state) {
+std::shared_ptr<const Preintegration> BenchPreintegration() {
   auto preint = std::make_shared<Preintegration>(Vec3::Zero(), Vec3::Zero(), 1e-4, 1e-3);
   for (int k = 0; k < 100; ++k) preint->Integrate(Vec3(0.01, 0.0, 0.1), Vec3(0.2, 0.0, 9.8), 0.01);
-  Blocks b;
-  EvaluateLoop(state, ImuFactor::Create(preint, Vec3(0, 0, -9.8)), {b.pose_i, b.vel_i, b.bias_i, b.pose_j, b.vel_j});
+  return preint;
 }
-BENCHMARK(BM_ImuFactor);
+
+// Production: analytic Jacobians (ImuCostFunction).
+void BM_ImuFactorAnalytic(benchmark::State& state) {
+  Blocks b;
+  EvaluateLoop(state, ImuFactor::Create(BenchPreintegration(), Vec3(0, 0, -9.8)),
+               {b.pose_i, b.vel_i, b.bias_i, b.pose_j, b.vel_j});
+}
+BENCHMARK(BM_ImuFactorAnalytic);
+
+// The test oracle: AutoDiffCostFunction of the same residual (Jet<double, 26>).
+void BM_ImuFactorAutoDiff(benchmark::State& state) {
+  Blocks b;
+  EvaluateLoop(state, ImuFactor::CreateAutoDiff(BenchPreintegration(), Vec3(0, 0, -9.8)),
+               {b.pose_i, b.vel_i, b.bias_i, b.pose_j, b.vel_j});
+}
+BENCHMARK(BM_ImuFactorAutoDiff);
 
 void BM_GnssFactor(benchmark::State& state) {
   Blocks b;

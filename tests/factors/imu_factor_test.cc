@@ -5,6 +5,8 @@
 
 #include <memory>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "core/imu_kernel.h"
 #include "core/preintegration.h"
@@ -83,10 +85,187 @@ TEST(ImuFactorTest, ResidualWithBiasCorrectionAtTruth) {
   EXPECT_LT(r_raw.norm(), 1e-4);
 }
 
+// A set of evaluation points for comparing the analytic and autodiff cost functions.
+struct ProbePoint {
+  std::string name;
+  std::shared_ptr<const Preintegration> preint;
+  test::PoseBlock pose_i, pose_j;
+  Vec3 vel_i, vel_j;
+  Vec6 bias;
+  std::vector<const double*> params() const {
+    return {pose_i.data(), vel_i.data(), bias.data(), pose_j.data(), vel_j.data()};
+  }
+};
+
+// Scenarios: intervals from one sample to 10 s (ΔR of several radians), biases at and far from the
+// linearisation point; at each, the truth, random points (rotation errors ~1 rad, velocity errors ~1 m/s,
+// bias errors) and a point whose quaternions are given as −q.
+std::vector<ProbePoint> ProbePoints() {
+  struct Config {
+    std::string name;
+    int num_samples;
+    double dt;
+    Vec6 bias_lin_offset;
+  };
+  Vec6 small, large;
+  small << 1e-3, -2e-3, 1e-3, 1e-2, -1e-2, 2e-2;
+  large << 0.05, -0.04, 0.06, 0.5, -0.4, 0.3;
+  const std::vector<Config> configs = {{"100 x 10 ms, small db", 100, 0.01, small},
+                                       {"100 x 10 ms, db = 0", 100, 0.01, Vec6::Zero()},
+                                       {"1000 x 10 ms, large db", 1000, 0.01, large},
+                                       {"400 x 5 ms, large db", 400, 0.005, large},
+                                       {"3 x 5 ms, small db", 3, 0.005, small},
+                                       {"1 x 10 ms (one sample), large db", 1, 0.01, large}};
+  std::vector<ProbePoint> points;
+  std::mt19937 rng(11);
+  for (const Config& c : configs) {
+    const ImuScenario s = MakeScenario(c.num_samples, c.dt, c.bias_lin_offset);
+    ProbePoint truth{c.name + ", truth", s.preint, s.pose_i, s.pose_j, s.vel_i, s.vel_j, s.bias};
+    points.push_back(truth);
+    for (int trial = 0; trial < 4; ++trial) {
+      ProbePoint p = truth;
+      p.name = c.name + ", random " + std::to_string(trial);
+      Vec6 d_i, d_j;
+      d_i << test::RandomVec3(rng, 1.0), test::RandomVec3(rng, 0.5);
+      d_j << test::RandomVec3(rng, 1.0), test::RandomVec3(rng, 0.5);
+      p.pose_i = test::PosePlus(s.pose_i, d_i);
+      p.pose_j = test::PosePlus(s.pose_j, d_j);
+      p.vel_i += test::RandomVec3(rng, 1.0);
+      p.vel_j += test::RandomVec3(rng, 1.0);
+      p.bias.head<3>() += test::RandomVec3(rng, 0.03);
+      p.bias.tail<3>() += test::RandomVec3(rng, 0.3);
+      points.push_back(p);
+    }
+    ProbePoint flipped = points.back();
+    flipped.name = c.name + ", -q";
+    for (int k = pose::kQ; k < pose::kAmbient; ++k) {
+      flipped.pose_i[k] = -flipped.pose_i[k];
+      flipped.pose_j[k] = -flipped.pose_j[k];
+    }
+    points.push_back(flipped);
+  }
+  return points;
+}
+
+struct Evaluation {
+  Vec9 r;
+  std::vector<MatX> J_amb;  // 9 × ambient size, per block
+  std::vector<MatX> J_tan;  // 9 × tangent size (ambient × PlusJacobian for the poses)
+};
+
+Evaluation EvaluateWithJacobians(const ceres::CostFunction& cost, const ProbePoint& p) {
+  using RowMajorMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const std::vector<int32_t>& sizes = cost.parameter_block_sizes();
+  std::vector<RowMajorMat> J(sizes.size());
+  std::vector<double*> jac_ptrs;
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    J[k] = RowMajorMat::Constant(9, sizes[k], std::nan(""));
+    jac_ptrs.push_back(J[k].data());
+  }
+  Evaluation e;
+  const std::vector<const double*> params = p.params();
+  EXPECT_TRUE(cost.Evaluate(params.data(), e.r.data(), jac_ptrs.data()));
+  const PoseManifold manifold;
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    e.J_amb.push_back(J[k]);
+    if (sizes[k] == pose::kAmbient) {
+      Eigen::Matrix<double, 7, 6, Eigen::RowMajor> P;
+      manifold.PlusJacobian(params[k], P.data());
+      e.J_tan.push_back(J[k] * P);
+    } else {
+      e.J_tan.push_back(J[k]);
+    }
+  }
+  return e;
+}
+
+TEST(ImuFactorTest, AnalyticResidualMatchesAutoDiff) {
+  double worst_abs = 0.0, worst_rel = 0.0;
+  for (const ProbePoint& p : ProbePoints()) {
+    const std::unique_ptr<ceres::CostFunction> analytic(ImuFactor::Create(p.preint, GravityWorld(kG)));
+    const std::unique_ptr<ceres::CostFunction> autodiff(ImuFactor::CreateAutoDiff(p.preint, GravityWorld(kG)));
+    const std::vector<const double*> params = p.params();
+    Vec9 r_analytic, r_autodiff;
+    ASSERT_TRUE(analytic->Evaluate(params.data(), r_analytic.data(), nullptr));
+    ASSERT_TRUE(autodiff->Evaluate(params.data(), r_autodiff.data(), nullptr));
+    // With Jacobians requested the residual is the same.
+    const Evaluation e = EvaluateWithJacobians(*analytic, p);
+    EXPECT_EQ(e.r, r_analytic) << p.name;
+    const double diff = (r_analytic - r_autodiff).cwiseAbs().maxCoeff();
+    const double rel = diff / std::max(1.0, r_autodiff.cwiseAbs().maxCoeff());
+    EXPECT_LE(rel, 1e-12) << p.name << "\nanalytic " << r_analytic.transpose() << "\nautodiff "
+                          << r_autodiff.transpose();
+    worst_abs = std::max(worst_abs, diff);
+    worst_rel = std::max(worst_rel, rel);
+  }
+  std::printf("[ imu res  ] analytic vs autodiff residual: max |Δr| = %.2g (relative to max(1, |r|∞): %.2g)\n",
+              worst_abs, worst_rel);
+}
+
+TEST(ImuFactorTest, AnalyticJacobiansMatchAutoDiff) {
+  const char* kBlockNames[] = {"pose_i", "vel_i", "bias_i", "pose_j", "vel_j"};
+  double worst = 0.0, worst_row = 0.0;
+  int num_points = 0;
+  for (const ProbePoint& p : ProbePoints()) {
+    const std::unique_ptr<ceres::CostFunction> analytic(ImuFactor::Create(p.preint, GravityWorld(kG)));
+    const std::unique_ptr<ceres::CostFunction> autodiff(ImuFactor::CreateAutoDiff(p.preint, GravityWorld(kG)));
+    const Evaluation a = EvaluateWithJacobians(*analytic, p);
+    const Evaluation b = EvaluateWithJacobians(*autodiff, p);
+    for (size_t k = 0; k < a.J_tan.size(); ++k) {
+      ASSERT_TRUE(a.J_amb[k].allFinite()) << p.name << " " << kBlockNames[k];
+      // Tangent Jacobians (what Ceres uses) agree, relative to the block's largest entry.
+      const double scale = std::max(b.J_tan[k].cwiseAbs().maxCoeff(), 1e-300);
+      const double err = (a.J_tan[k] - b.J_tan[k]).cwiseAbs().maxCoeff() / scale;
+      EXPECT_LE(err, 1e-9) << p.name << ", block " << kBlockNames[k] << "\nanalytic\n"
+                           << a.J_tan[k] << "\nautodiff\n"
+                           << b.J_tan[k];
+      worst = std::max(worst, err);
+      // Stricter: relative to the largest entry of each row of the block.
+      for (int i = 0; i < 9; ++i) {
+        const double row_scale = std::max(b.J_tan[k].row(i).cwiseAbs().maxCoeff(), 1e-300);
+        worst_row = std::max(worst_row, (a.J_tan[k] - b.J_tan[k]).row(i).cwiseAbs().maxCoeff() / row_scale);
+      }
+    }
+    // The pose blocks' ambient Jacobians are the tangent ones lifted by PoseManifold's MinusJacobian.
+    const PoseManifold manifold;
+    const std::vector<const double*> params = p.params();
+    for (size_t k : {size_t{0}, size_t{3}}) {
+      Eigen::Matrix<double, 6, 7, Eigen::RowMajor> M;
+      manifold.MinusJacobian(params[k], M.data());
+      const double scale = a.J_amb[k].cwiseAbs().maxCoeff();
+      EXPECT_LE((a.J_amb[k] - a.J_tan[k] * M).cwiseAbs().maxCoeff(), 1e-12 * scale) << p.name;
+    }
+    ++num_points;
+  }
+  std::printf("[ imu jac  ] analytic vs autodiff tangent Jacobians over %d points: worst %.2g (relative to the "
+              "block's largest entry; %.2g relative to each row's)\n",
+              num_points, worst, worst_row);
+}
+
+TEST(ImuFactorTest, AnalyticJacobiansOfSomeBlocksOnly) {
+  // Ceres passes nullptr for the Jacobians of constant blocks: the others must not change.
+  const ProbePoint p = ProbePoints()[2];
+  const std::unique_ptr<ceres::CostFunction> cost(ImuFactor::Create(p.preint, GravityWorld(kG)));
+  const Evaluation full = EvaluateWithJacobians(*cost, p);
+  for (int k = 0; k < 5; ++k) {
+    Eigen::Matrix<double, 9, 7, Eigen::RowMajor> J;
+    std::vector<double*> jac_ptrs(5, nullptr);
+    jac_ptrs[k] = J.data();
+    Vec9 r;
+    const std::vector<const double*> params = p.params();
+    ASSERT_TRUE(cost->Evaluate(params.data(), r.data(), jac_ptrs.data()));
+    EXPECT_EQ(r, full.r);
+    const int n = cost->parameter_block_sizes()[k];
+    const Eigen::Map<const Eigen::Matrix<double, 9, Eigen::Dynamic, Eigen::RowMajor>> J_k(J.data(), 9, n);
+    EXPECT_EQ(MatX(J_k), full.J_amb[k]) << "block " << k;
+  }
+}
+
 TEST(ImuFactorTest, JacobiansMatchNumeric) {
   Vec6 offset;
   offset << 1e-3, -2e-3, 1e-3, 1e-2, -1e-2, 2e-2;
   const ImuScenario s = MakeScenario(100, 0.01, offset);
+  // The production cost function (analytic Jacobians).
   std::unique_ptr<ceres::CostFunction> cost(ImuFactor::Create(s.preint, GravityWorld(kG)));
   ASSERT_EQ(cost->num_residuals(), 9);
   ASSERT_EQ(cost->parameter_block_sizes(), (std::vector<int32_t>{7, 3, 6, 7, 3}));

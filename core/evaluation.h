@@ -1,12 +1,17 @@
 // Accuracy against a truth file (DESIGN §5), computed as the estimate streams in: the estimate is
-// interpolated at each truth time it brackets, so memory holds the truth only.
+// interpolated at each truth time it brackets, and the truth is read as the estimate advances, so memory
+// holds neither.
 #pragma once
 
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/geodesy.h"
 #include "core/nav_state.h"
+
+struct gzFile_s;  // zlib's gzFile
 
 namespace gins {
 
@@ -17,9 +22,34 @@ struct TruthSample {
   Vec3 v_w = Vec3::Zero();
 };
 
-// Reads t,lat,lon,alt,qw,qx,qy,qz,ve,vn,vu (plain or gzip) into the world frame: positions through the
-// geodesy, attitude and velocity (given in the local ENU frame at each row's point) rotated into w. Rows
-// not later than the previous row are dropped. Throws InputError naming file and line on malformed rows.
+// Reads t,lat,lon,alt,qw,qx,qy,qz,ve,vn,vu (plain or gzip) row by row into the world frame: positions
+// through the geodesy, attitude and velocity (given in the local ENU frame at each row's point) rotated
+// into w. Memory holds one row. Rows not later than the previous row are dropped. Throws InputError naming
+// file and line on malformed rows (when reaching them), and for a file that cannot be opened or has no rows.
+class TruthReader {
+ public:
+  TruthReader(const std::string& path, const LocalEnuFrame& frame);
+  ~TruthReader();
+  TruthReader(const TruthReader&) = delete;
+  TruthReader& operator=(const TruthReader&) = delete;
+
+  // The next sample in strictly increasing time; false at the end.
+  bool Next(TruthSample* sample);
+  const std::string& path() const { return path_; }
+
+ private:
+  struct GzClose {
+    void operator()(gzFile_s* f) const;
+  };
+  std::string path_;
+  LocalEnuFrame frame_;
+  std::unique_ptr<gzFile_s, GzClose> file_;
+  uint64_t line_ = 0;
+  bool any_ = false;
+  double last_t_ = 0.0;
+};
+
+// The whole truth file at once (TruthReader's rows and errors).
 std::vector<TruthSample> ReadTruth(const std::string& path, const LocalEnuFrame& frame);
 
 struct AccuracyMetrics {
@@ -32,6 +62,10 @@ struct AccuracyMetrics {
 
 class StreamingEvaluator {
  public:
+  // Pulls the truth from `truth` (the next sample in increasing time, false at the end) as the estimates
+  // advance, so memory holds one truth sample, e.g. from its own TruthReader.
+  explicit StreamingEvaluator(std::function<bool(TruthSample*)> truth);
+  // Over truth samples held in memory.
   explicit StreamingEvaluator(std::vector<TruthSample> truth);
   // Estimates must arrive in non-decreasing time.
   void Add(const NavState& x);
@@ -39,8 +73,10 @@ class StreamingEvaluator {
 
  private:
   void Accumulate(const TruthSample& truth, const NavState& est);
-  std::vector<TruthSample> truth_;
-  size_t next_ = 0;
+  void NextTruth() { have_next_ = truth_(&next_); }
+  std::function<bool(TruthSample*)> truth_;
+  TruthSample next_;  // the first truth sample not yet passed
+  bool have_next_ = false;
   bool have_prev_ = false;
   NavState prev_;
   uint64_t n_ = 0;

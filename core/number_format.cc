@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <string>
 
 namespace gins {
 namespace {
@@ -116,6 +117,21 @@ char* FormatScientific(char* first, char* last, double v, int precision) {
   *p++ = e < 0 ? '-' : '+';
   p = WriteDigits(p, last, static_cast<uint64_t>(std::abs(e)), 2);
   return p == nullptr ? first : p;
+}
+
+double ParseDouble(const char* first, const char* last, const char** end) {
+  double v = 0.0;
+  const std::from_chars_result r = std::from_chars(first, last, v);
+  // from_chars stops at the 'x' of "0x1p3", where strtod reads a hex number.
+  if (r.ec == std::errc() && std::isfinite(v) && (r.ptr == last || (*r.ptr != 'x' && *r.ptr != 'X'))) {
+    *end = r.ptr;
+    return v;
+  }
+  const std::string text(first, last);  // rare: strtod needs the end marked
+  char* stop = nullptr;
+  v = std::strtod(text.c_str(), &stop);
+  *end = first + (stop - text.c_str());
+  return v;
 }
 
 }  // namespace gins

@@ -46,40 +46,127 @@ std::string AlignmentName(Alignment a) {
   return "none";
 }
 
+SampleSource VectorSource(const std::vector<TrajectorySample>& samples) {
+  return [&samples, i = size_t{0}](TrajectorySample* s) mutable {
+    if (i == samples.size()) return false;
+    *s = samples[i++];
+    return true;
+  };
+}
+
+namespace {
+
+// Histogram bins: 1024 per octave over [2^kMinExponent, 2^kMaxExponent) s; frexp's mantissa in [0.5, 1).
+constexpr int kBinsPerOctave = 1024;
+constexpr int kMinExponent = -40, kMaxExponent = 40;
+
+size_t IntervalBin(double dt) {
+  if (!(dt > 0.0)) return 0;
+  int e = 0;
+  const double m = std::frexp(dt, &e);
+  if (e <= kMinExponent) return 0;
+  if (e > kMaxExponent) return static_cast<size_t>((kMaxExponent - kMinExponent) * kBinsPerOctave - 1);
+  const int k = std::min(kBinsPerOctave - 1, static_cast<int>((m - 0.5) * 2.0 * kBinsPerOctave));
+  return static_cast<size_t>((e - 1 - kMinExponent) * kBinsPerOctave + k);
+}
+
+// The middle of a bin.
+double IntervalBinCentre(size_t bin) {
+  const int e = static_cast<int>(bin / kBinsPerOctave) + 1 + kMinExponent;
+  const double k = static_cast<double>(bin % kBinsPerOctave);
+  return std::ldexp(0.5 + (k + 0.5) / (2.0 * kBinsPerOctave), e);
+}
+
+}  // namespace
+
+void IntervalMedian::Add(double t) {
+  if (have_last_) {
+    const double dt = t - last_t_;
+    ++count_;
+    if (histogram_.empty()) {
+      ++exact_[dt];
+      if (exact_.size() > kExactValues) {
+        for (const auto& [value, n] : exact_) AddToHistogram(value, n);
+        exact_.clear();
+      }
+    } else {
+      AddToHistogram(dt, 1);
+    }
+  }
+  have_last_ = true;
+  last_t_ = t;
+}
+
+void IntervalMedian::AddToHistogram(double dt, uint64_t count) {
+  if (histogram_.empty()) histogram_.assign(static_cast<size_t>((kMaxExponent - kMinExponent) * kBinsPerOctave), 0);
+  histogram_[IntervalBin(dt)] += count;
+}
+
+std::optional<double> IntervalMedian::Median() const {
+  if (count_ == 0) return std::nullopt;
+  const uint64_t mid = count_ / 2;  // 0-based position in sorted order
+  uint64_t below = 0;
+  if (histogram_.empty()) {
+    for (const auto& [value, n] : exact_) {
+      below += n;
+      if (below > mid) return value;
+    }
+  } else {
+    for (size_t bin = 0; bin < histogram_.size(); ++bin) {
+      below += histogram_[bin];
+      if (below > mid) return IntervalBinCentre(bin);
+    }
+  }
+  return std::nullopt;  // not reached: the counts add up to count_
+}
+
+double EffectiveMaxGap(const IntervalMedian& estimate_intervals, double max_gap) {
+  const std::optional<double> median = estimate_intervals.Median();
+  return median ? std::max(max_gap, kMedianGapFactor * *median) : max_gap;
+}
+
 double EffectiveMaxGap(const std::vector<TrajectorySample>& estimate, double max_gap) {
-  if (estimate.size() < 2) return max_gap;
-  std::vector<double> dt(estimate.size() - 1);
-  for (size_t i = 1; i < estimate.size(); ++i) dt[i - 1] = estimate[i].t - estimate[i - 1].t;
-  const auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
-  std::nth_element(dt.begin(), mid, dt.end());
-  return std::max(max_gap, kMedianGapFactor * *mid);
+  IntervalMedian intervals;
+  for (const TrajectorySample& s : estimate) intervals.Add(s.t);
+  return EffectiveMaxGap(intervals, max_gap);
+}
+
+EstimateMatcher::EstimateMatcher(SampleSource estimate, double max_gap)
+    : estimate_(std::move(estimate)), max_gap_(max_gap) {
+  has_b_ = estimate_(&b_);
+}
+
+EstimateMatcher::Result EstimateMatcher::At(double t, TrajectorySample* est) {
+  while (has_b_ && b_.t <= t) {
+    a_ = b_;
+    has_a_ = true;
+    has_b_ = estimate_(&b_);
+  }
+  if (!has_a_) return Result::kOutsideSpan;  // before the estimate's first sample
+  if (a_.t == t) {
+    *est = a_;  // an estimate at the reference time itself
+    return Result::kMatched;
+  }
+  if (!has_b_) return Result::kOutsideSpan;  // after its last
+  const double span = b_.t - a_.t;
+  if (span > max_gap_) return Result::kInGap;
+  const double f = (t - a_.t) / span;
+  est->t = t;
+  est->p_w = (1.0 - f) * a_.p_w + f * b_.p_w;
+  est->v_w = (1.0 - f) * a_.v_w + f * b_.v_w;
+  est->q_wb = a_.q_wb.slerp(f, b_.q_wb);
+  return Result::kMatched;
 }
 
 std::vector<MatchedPair> MatchAtReferenceTimes(const std::vector<TrajectorySample>& reference,
                                                const std::vector<TrajectorySample>& estimate, double max_gap) {
   std::vector<MatchedPair> pairs;
-  if (estimate.empty()) return pairs;
-  size_t k = 0;
+  EstimateMatcher matcher(VectorSource(estimate), max_gap);
   for (size_t i = 0; i < reference.size(); ++i) {
-    const TrajectorySample& r = reference[i];
-    if (r.t < estimate.front().t || r.t > estimate.back().t) continue;
-    while (k + 1 < estimate.size() && estimate[k + 1].t <= r.t) ++k;
-    const TrajectorySample& a = estimate[k];
     MatchedPair m;
+    if (matcher.At(reference[i].t, &m.est) != EstimateMatcher::Result::kMatched) continue;
     m.ref_index = i;
-    m.ref = r;
-    if (a.t == r.t) {
-      m.est = a;  // an estimate at the reference time itself
-    } else {
-      const TrajectorySample& b = estimate[k + 1];  // exists: r.t < estimate.back().t here
-      const double span = b.t - a.t;
-      if (span > max_gap) continue;
-      const double f = (r.t - a.t) / span;
-      m.est.t = r.t;
-      m.est.p_w = (1.0 - f) * a.p_w + f * b.p_w;
-      m.est.v_w = (1.0 - f) * a.v_w + f * b.v_w;
-      m.est.q_wb = a.q_wb.slerp(f, b.q_wb);
-    }
+    m.ref = reference[i];
     pairs.push_back(m);
   }
   return pairs;
@@ -117,119 +204,151 @@ RigidTransform FitAlignment(const std::vector<MatchedPair>& pairs, Alignment ali
   return T;
 }
 
+TrajectoryEvaluator::TrajectoryEvaluator(SampleSource estimate, bool with_velocity, double max_gap,
+                                         const MetricOptions& options, const RigidTransform& align)
+    : matcher_(std::move(estimate), max_gap), with_velocity_(with_velocity), max_gap_(max_gap), options_(options),
+      align_(options.alignment == Alignment::kNone ? RigidTransform() : align), q_align_(align_.R) {
+  for (const TimeWindow& w : options_.outages) {
+    OutageDrift o;
+    o.window = w;
+    outages_.push_back(o);
+    by_begin_.push_back(by_begin_.size());
+  }
+  std::stable_sort(by_begin_.begin(), by_begin_.end(), [&](size_t a, size_t b) {
+    return options_.outages[a].begin < options_.outages[b].begin;
+  });
+}
+
+void TrajectoryEvaluator::AddReference(const TrajectorySample& ref) {
+  if (have_ref_) travelled_ += (ref.p_w - last_ref_p_w_).norm();
+  have_ref_ = true;
+  last_ref_p_w_ = ref.p_w;
+  TrajectorySample est;
+  const EstimateMatcher::Result result = matcher_.At(ref.t, &est);
+  reference_in_span_ += result != EstimateMatcher::Result::kOutsideSpan;
+  if (result != EstimateMatcher::Result::kMatched) {
+    open_segments_.clear();  // no segment may span an unevaluated reference sample
+    return;
+  }
+  if (options_.alignment != Alignment::kNone) {
+    est.p_w = align_.R * est.p_w + align_.t;
+    est.q_wb = (q_align_ * est.q_wb).normalized();
+    est.v_w = align_.R * est.v_w;
+  }
+  AddPair(ref, est);
+}
+
+void TrajectoryEvaluator::AddPair(const TrajectorySample& ref, const TrajectorySample& est) {
+  // Absolute errors.
+  const Vec3 d = est.p_w - ref.p_w;
+  se_ += d.x() * d.x();
+  sn_ += d.y() * d.y();
+  su_ += d.z() * d.z();
+  const double err_h = d.head<2>().norm();
+  sum_h_ += err_h;
+  if (err_h > max_h_) {
+    max_h_ = err_h;
+    t_max_h_ = ref.t;
+  }
+  svel_ += (est.v_w - ref.v_w).squaredNorm();
+  satt_ += LogQuat<double>(ref.q_wb.conjugate() * est.q_wb).squaredNorm();
+  const double dyaw =
+      WrapAngle(YawOfXAxis<double>(est.q_wb.toRotationMatrix()) - YawOfXAxis<double>(ref.q_wb.toRotationMatrix()));
+  syaw_ += dyaw * dyaw;
+  max_heading_deg_ = std::max(max_heading_deg_, std::abs(dyaw) * kRadToDeg);
+  ++samples_;
+
+  // Relative error: this pair ends the segments of the open starts it is segment_length or more beyond (the
+  // oldest first: the first pair that far along the path ends each), then starts one.
+  if (options_.segment_length > 0.0) {
+    while (!open_segments_.empty() && !(travelled_ - open_segments_.front().travelled < options_.segment_length)) {
+      const SegmentStart& i = open_segments_.front();
+      const double dist = travelled_ - i.travelled;
+      const Vec3 d_est = est.p_w - i.p_est_w;
+      const Vec3 d_ref = ref.p_w - i.p_ref_w;
+      const double pct = 100.0 * (d_est - d_ref).norm() / dist;
+      rel_sum_ += pct;
+      rel_sq_ += pct * pct;
+      rel_max_ = std::max(rel_max_, pct);
+      ++segments_;
+      open_segments_.pop_front();
+    }
+    open_segments_.push_back({travelled_, est.p_w, ref.p_w});
+  }
+
+  // Drift over outages: the windows holding this time.
+  while (next_window_ < by_begin_.size() && options_.outages[by_begin_[next_window_]].begin <= ref.t) {
+    open_windows_.push_back(by_begin_[next_window_++]);
+  }
+  for (size_t w : open_windows_) {
+    if (ref.t > options_.outages[w].end) continue;
+    OutageDrift& o = outages_[w];
+    if (o.samples == 0 || err_h > o.max_h) {
+      o.max_h = err_h;
+      o.t_max = ref.t;
+    }
+    o.final_h = err_h;
+    ++o.samples;
+  }
+  open_windows_.erase(std::remove_if(open_windows_.begin(), open_windows_.end(),
+                                     [&](size_t w) { return ref.t > options_.outages[w].end; }),
+                      open_windows_.end());
+}
+
+TrajectoryMetrics TrajectoryEvaluator::Metrics() const {
+  if (samples_ == 0) throw std::invalid_argument("no reference time falls inside the estimate's time span");
+  TrajectoryMetrics m;
+  m.max_gap = max_gap_;
+  m.alignment = options_.alignment;
+  m.align = align_;
+  m.reference_in_span = reference_in_span_;
+  m.samples = samples_;
+  const double n = static_cast<double>(samples_);
+  m.rmse_e = std::sqrt(se_ / n);
+  m.rmse_n = std::sqrt(sn_ / n);
+  m.rmse_v = std::sqrt(su_ / n);
+  m.rmse_h = std::sqrt((se_ + sn_) / n);
+  m.rmse_3d = std::sqrt((se_ + sn_ + su_) / n);
+  m.mean_h = sum_h_ / n;
+  m.max_h = max_h_;
+  m.t_max_h = t_max_h_;
+  if (with_velocity_) m.rmse_vel = std::sqrt(svel_ / n);
+  m.rmse_att_deg = std::sqrt(satt_ / n) * kRadToDeg;
+  m.rmse_heading_deg = std::sqrt(syaw_ / n) * kRadToDeg;
+  m.max_heading_deg = max_heading_deg_;
+
+  m.segment_length = options_.segment_length;
+  m.segments = segments_;
+  m.rel_max_pct = rel_max_;
+  if (segments_ > 0) {
+    m.rel_mean_pct = rel_sum_ / static_cast<double>(segments_);
+    m.rel_rms_pct = std::sqrt(rel_sq_ / static_cast<double>(segments_));
+  }
+
+  m.outages = outages_;
+  double outage_sq = 0.0;
+  for (const OutageDrift& o : outages_) {
+    if (o.samples == 0) continue;
+    ++m.outages_scored;
+    outage_sq += o.max_h * o.max_h;
+    m.outage_max = std::max(m.outage_max, o.max_h);
+  }
+  if (m.outages_scored > 0) m.outage_rms = std::sqrt(outage_sq / static_cast<double>(m.outages_scored));
+  return m;
+}
+
 TrajectoryMetrics EvaluateTrajectory(const std::vector<TrajectorySample>& reference, bool reference_has_velocity,
                                      const std::vector<TrajectorySample>& estimate, bool estimate_has_velocity,
                                      const MetricOptions& options) {
   const double max_gap = EffectiveMaxGap(estimate, options.max_gap);
-  std::vector<MatchedPair> pairs = MatchAtReferenceTimes(reference, estimate, max_gap);
-  if (pairs.empty()) throw std::invalid_argument("no reference time falls inside the estimate's time span");
-  TrajectoryMetrics m;
-  m.max_gap = max_gap;
-  m.alignment = options.alignment;
-  m.align = FitAlignment(pairs, options.alignment);
+  RigidTransform align;
   if (options.alignment != Alignment::kNone) {
-    const Quat q_align(m.align.R);
-    for (MatchedPair& p : pairs) {
-      p.est.p_w = m.align.R * p.est.p_w + m.align.t;
-      p.est.q_wb = (q_align * p.est.q_wb).normalized();
-      p.est.v_w = m.align.R * p.est.v_w;
-    }
+    align = FitAlignment(MatchAtReferenceTimes(reference, estimate, max_gap), options.alignment);
   }
-  for (const TrajectorySample& r : reference) {
-    m.reference_in_span += r.t >= estimate.front().t && r.t <= estimate.back().t;
-  }
-
-  // Absolute errors.
-  const double n = static_cast<double>(pairs.size());
-  double se = 0.0, sn = 0.0, su = 0.0, sum_h = 0.0, svel = 0.0, satt = 0.0, syaw = 0.0;
-  std::vector<double> err_h(pairs.size());
-  for (size_t i = 0; i < pairs.size(); ++i) {
-    const MatchedPair& p = pairs[i];
-    const Vec3 d = p.est.p_w - p.ref.p_w;
-    se += d.x() * d.x();
-    sn += d.y() * d.y();
-    su += d.z() * d.z();
-    err_h[i] = d.head<2>().norm();
-    sum_h += err_h[i];
-    if (err_h[i] > m.max_h) {
-      m.max_h = err_h[i];
-      m.t_max_h = p.ref.t;
-    }
-    svel += (p.est.v_w - p.ref.v_w).squaredNorm();
-    satt += LogQuat<double>(p.ref.q_wb.conjugate() * p.est.q_wb).squaredNorm();
-    const double dyaw =
-        WrapAngle(YawOfXAxis<double>(p.est.q_wb.toRotationMatrix()) - YawOfXAxis<double>(p.ref.q_wb.toRotationMatrix()));
-    syaw += dyaw * dyaw;
-    m.max_heading_deg = std::max(m.max_heading_deg, std::abs(dyaw) * kRadToDeg);
-  }
-  m.samples = pairs.size();
-  m.rmse_e = std::sqrt(se / n);
-  m.rmse_n = std::sqrt(sn / n);
-  m.rmse_v = std::sqrt(su / n);
-  m.rmse_h = std::sqrt((se + sn) / n);
-  m.rmse_3d = std::sqrt((se + sn + su) / n);
-  m.mean_h = sum_h / n;
-  if (reference_has_velocity && estimate_has_velocity) m.rmse_vel = std::sqrt(svel / n);
-  m.rmse_att_deg = std::sqrt(satt / n) * kRadToDeg;
-  m.rmse_heading_deg = std::sqrt(syaw / n) * kRadToDeg;
-
-  // Relative error over travelled distance.
-  m.segment_length = options.segment_length;
-  std::vector<double> travelled(reference.size(), 0.0);
-  for (size_t i = 1; i < reference.size(); ++i) {
-    travelled[i] = travelled[i - 1] + (reference[i].p_w - reference[i - 1].p_w).norm();
-  }
-  std::vector<size_t> run(pairs.size(), 0);  // pairs with the same run id have no reference sample skipped
-  for (size_t i = 1; i < pairs.size(); ++i) {
-    run[i] = run[i - 1] + (pairs[i].ref_index == pairs[i - 1].ref_index + 1 ? 0 : 1);
-  }
-  double rel_sum = 0.0, rel_sq = 0.0;
-  size_t j = 0;
-  for (size_t i = 0; i < pairs.size() && options.segment_length > 0.0; ++i) {
-    const double start = travelled[pairs[i].ref_index];
-    j = std::max(j, i + 1);
-    while (j < pairs.size() && travelled[pairs[j].ref_index] - start < options.segment_length) ++j;
-    if (j >= pairs.size()) break;  // later starts reach no further
-    if (run[j] != run[i]) continue;
-    const double dist = travelled[pairs[j].ref_index] - start;
-    const Vec3 d_est = pairs[j].est.p_w - pairs[i].est.p_w;
-    const Vec3 d_ref = pairs[j].ref.p_w - pairs[i].ref.p_w;
-    const double pct = 100.0 * (d_est - d_ref).norm() / dist;
-    rel_sum += pct;
-    rel_sq += pct * pct;
-    m.rel_max_pct = std::max(m.rel_max_pct, pct);
-    ++m.segments;
-  }
-  if (m.segments > 0) {
-    m.rel_mean_pct = rel_sum / static_cast<double>(m.segments);
-    m.rel_rms_pct = std::sqrt(rel_sq / static_cast<double>(m.segments));
-  }
-
-  // Drift over outages.
-  double outage_sq = 0.0;
-  for (const TimeWindow& w : options.outages) {
-    OutageDrift o;
-    o.window = w;
-    const auto first = std::lower_bound(pairs.begin(), pairs.end(), w.begin,
-                                        [](const MatchedPair& p, double t) { return p.ref.t < t; });
-    for (auto it = first; it != pairs.end() && it->ref.t <= w.end; ++it) {
-      const double h = err_h[static_cast<size_t>(it - pairs.begin())];
-      if (o.samples == 0 || h > o.max_h) {
-        o.max_h = h;
-        o.t_max = it->ref.t;
-      }
-      o.final_h = h;
-      ++o.samples;
-    }
-    if (o.samples > 0) {
-      ++m.outages_scored;
-      outage_sq += o.max_h * o.max_h;
-      m.outage_max = std::max(m.outage_max, o.max_h);
-    }
-    m.outages.push_back(o);
-  }
-  if (m.outages_scored > 0) m.outage_rms = std::sqrt(outage_sq / static_cast<double>(m.outages_scored));
-  return m;
+  TrajectoryEvaluator evaluator(VectorSource(estimate), reference_has_velocity && estimate_has_velocity, max_gap,
+                                options, align);
+  for (const TrajectorySample& r : reference) evaluator.AddReference(r);
+  return evaluator.Metrics();
 }
 
 }  // namespace gins

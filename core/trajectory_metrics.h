@@ -5,9 +5,9 @@
 // Definitions (both trajectories in one ENU frame):
 // - Pairs: the estimate is interpolated at each reference time it brackets (position and velocity
 //   linearly, attitude by slerp) when its two samples are at most max(max_gap, 3 × the estimate's median
-//   sample interval) apart (1 s for IMU-rate outputs; a keyframe-rate output at ~1 Hz gets 3 s, so its
-//   slightly longer intervals in GNSS outages still count); reference times in larger estimate gaps, or
-//   outside the estimate's span, are not evaluated.
+//   sample interval (IntervalMedian)) apart (1 s for IMU-rate outputs; a keyframe-rate output at ~1 Hz gets
+//   3 s, so its slightly longer intervals in GNSS outages still count); reference times in larger estimate
+//   gaps, or outside the estimate's span, are not evaluated.
 // - Position errors e = p_est − p_ref: 3-D, horizontal |e_EN| and vertical e_U RMSE; largest horizontal.
 // - Velocity RMSE |v_est − v_ref| when both carry velocities.
 // - Attitude RMSE: RMS of |Log(R_refᵀ R_est)|; heading: RMS of the wrapped difference of the yaws of the body
@@ -22,8 +22,15 @@
 // - Alignment (off by default; for inputs that are not geo-referenced): the rigid transform of the
 //   estimate minimising Σ|R p_est + t − p_ref|² over the pairs: yaw + translation (4-DoF) or full SE(3)
 //   (Umeyama, no scale). It is applied to positions, attitudes and velocities before every metric.
+//
+// Without alignment everything is computed in one pass over the reference and the estimate, both streamed
+// (TrajectoryEvaluator), after a first pass over the estimate for its median interval: memory does not grow
+// with the log, so `gins run` can compare hours of IMU-rate outputs.
 #pragma once
 
+#include <deque>
+#include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,9 +48,37 @@ struct TimeWindow {
 // Sorted by begin, overlapping or touching windows merged into one.
 std::vector<TimeWindow> MergeWindows(std::vector<TimeWindow> windows);
 
+// Pulls the next sample (strictly increasing time) into *sample; false at the end. E.g. a TrajectoryReader.
+using SampleSource = std::function<bool(TrajectorySample* sample)>;
+// The samples of a vector in order (not copied: the vector must outlive the source).
+SampleSource VectorSource(const std::vector<TrajectorySample>& samples);
+
+// The median of the intervals between consecutive times (the interval at position n/2 of the sorted n,
+// as std::nth_element finds it), in bounded memory whatever the number of times: exact while the intervals
+// take at most kExactValues distinct values (our outputs' times are printed to 1 µs: an IMU-rate output has
+// a handful, a keyframe-rate one tens), else from a histogram on bins 2^-10 wide in relative terms (1024
+// per octave, intervals from 2^-40 s to 2^40 s), within 0.05 % — plenty for a gap threshold.
+class IntervalMedian {
+ public:
+  static constexpr size_t kExactValues = 1024;
+  // Times must increase.
+  void Add(double t);
+  // None with fewer than two times.
+  std::optional<double> Median() const;
+
+ private:
+  void AddToHistogram(double dt, uint64_t count);
+  bool have_last_ = false;
+  double last_t_ = 0.0;
+  uint64_t count_ = 0;
+  std::map<double, uint64_t> exact_;  // interval -> count, until there are too many distinct ones
+  std::vector<uint64_t> histogram_;   // then counts per bin (allocated when needed)
+};
+
 // The gap interpolated across is at least this many times the estimate's median sample interval.
 constexpr double kMedianGapFactor = 3.0;
-// max(max_gap, kMedianGapFactor × median interval of `estimate`).
+// max(max_gap, kMedianGapFactor × median interval of the estimate).
+double EffectiveMaxGap(const IntervalMedian& estimate_intervals, double max_gap);
 double EffectiveMaxGap(const std::vector<TrajectorySample>& estimate, double max_gap);
 
 enum class Alignment { kNone, kYaw, kSe3 };
@@ -68,6 +103,23 @@ struct MetricOptions {
 struct MatchedPair {
   size_t ref_index = 0;  // into the reference
   TrajectorySample ref, est;
+};
+
+// The estimate at reference times that do not decrease, merged from its stream by the pair rules above:
+// holds the two estimate samples around the current reference time, so memory does not grow with either.
+class EstimateMatcher {
+ public:
+  enum class Result { kOutsideSpan, kInGap, kMatched };
+  // Reads the estimate's first sample.
+  EstimateMatcher(SampleSource estimate, double max_gap);
+  // *est is set when kMatched: the estimate at `t` (its own sample there, or interpolated).
+  Result At(double t, TrajectorySample* est);
+
+ private:
+  SampleSource estimate_;
+  double max_gap_;
+  TrajectorySample a_, b_;  // the latest sample at or before the reference time, and the one after it
+  bool has_a_ = false, has_b_ = false;
 };
 
 std::vector<MatchedPair> MatchAtReferenceTimes(const std::vector<TrajectorySample>& reference,
@@ -104,7 +156,60 @@ struct TrajectoryMetrics {
   RigidTransform align;  // applied to the estimate (identity without alignment)
 };
 
-// Throws std::invalid_argument when nothing can be evaluated (no reference time inside the estimate).
+// Every metric of one estimate, accumulated as the reference streams by in time order; the estimate is
+// merged in from its own stream (EstimateMatcher). Memory does not grow with the trajectories' length: the
+// sums are running sums, and the relative error keeps a deque of the pairs of the last `segment_length`
+// metres of reference travel (the segment starts still waiting for their end), emptied at every
+// unevaluated reference sample; it is bounded by distance and by the length of a standstill, not by the log.
+// The numbers are those of the definitions above in the same order of summation (EvaluateTrajectory is
+// this over vectors).
+class TrajectoryEvaluator {
+ public:
+  // `max_gap`: EffectiveMaxGap of the estimate (a first pass over it). `with_velocity`: both the reference and
+  // the estimate carry velocities. With options.alignment other than none, `align` (FitAlignment over the
+  // pairs, also a first pass) is applied to each estimate before every metric.
+  TrajectoryEvaluator(SampleSource estimate, bool with_velocity, double max_gap, const MetricOptions& options,
+                      const RigidTransform& align = RigidTransform());
+  void AddReference(const TrajectorySample& ref);
+  // Throws std::invalid_argument when nothing was evaluated (no reference time inside the estimate).
+  TrajectoryMetrics Metrics() const;
+
+ private:
+  void AddPair(const TrajectorySample& ref, const TrajectorySample& est);
+
+  EstimateMatcher matcher_;
+  bool with_velocity_;
+  double max_gap_;
+  MetricOptions options_;
+  RigidTransform align_;
+  Quat q_align_;
+  uint64_t samples_ = 0, reference_in_span_ = 0;
+  // Absolute errors: sums of squares over the pairs (E, N, U, velocity, attitude, heading).
+  double se_ = 0.0, sn_ = 0.0, su_ = 0.0, sum_h_ = 0.0, svel_ = 0.0, satt_ = 0.0, syaw_ = 0.0;
+  double max_h_ = 0.0, t_max_h_ = 0.0, max_heading_deg_ = 0.0;
+  // Relative error: the reference's path length so far, and the pairs still waiting for the pair
+  // segment_length further on (starts with no unevaluated reference sample since).
+  bool have_ref_ = false;
+  Vec3 last_ref_p_w_ = Vec3::Zero();
+  double travelled_ = 0.0;
+  struct SegmentStart {
+    double travelled;
+    Vec3 p_est_w, p_ref_w;
+  };
+  std::deque<SegmentStart> open_segments_;
+  uint64_t segments_ = 0;
+  double rel_sum_ = 0.0, rel_sq_ = 0.0, rel_max_ = 0.0;
+  // Outage drift, per window of options_.outages; windows are opened in order of their begin and closed
+  // once the reference passes their end.
+  std::vector<OutageDrift> outages_;
+  std::vector<size_t> by_begin_;  // window indices sorted by begin
+  size_t next_window_ = 0;        // into by_begin_: the first window not yet opened
+  std::vector<size_t> open_windows_;
+};
+
+// The metrics over trajectories in memory: EffectiveMaxGap, FitAlignment over MatchAtReferenceTimes when
+// aligning, then TrajectoryEvaluator. Throws std::invalid_argument when nothing can be evaluated (no
+// reference time inside the estimate).
 TrajectoryMetrics EvaluateTrajectory(const std::vector<TrajectorySample>& reference, bool reference_has_velocity,
                                      const std::vector<TrajectorySample>& estimate, bool estimate_has_velocity,
                                      const MetricOptions& options);

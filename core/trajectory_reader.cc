@@ -10,30 +10,31 @@
 #include <sstream>
 
 #include "core/log_reader.h"
+#include "core/number_format.h"
 
 namespace gins {
 namespace {
 
-// Splits a row at commas and whitespace.
-std::vector<std::string> Fields(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : line) {
-    if (c == ',' || c == ' ' || c == '\t' || c == '\r' || c == '\n') {
-      if (!cur.empty()) out.push_back(cur);
-      cur.clear();
-    } else {
-      cur += c;
-    }
+bool IsSeparator(char c) { return c == ',' || c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+// Splits a row at commas and whitespace into [begin, end) ranges of `line`.
+void SplitFields(const std::string& line, std::vector<std::pair<size_t, size_t>>* fields) {
+  fields->clear();
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && IsSeparator(line[i])) ++i;
+    if (i == line.size()) break;
+    const size_t begin = i;
+    while (i < line.size() && !IsSeparator(line[i])) ++i;
+    fields->emplace_back(begin, i);
   }
-  if (!cur.empty()) out.push_back(cur);
-  return out;
 }
 
-bool ParseFinite(const std::string& s, double* v) {
-  char* end = nullptr;
-  *v = std::strtod(s.c_str(), &end);
-  return end != s.c_str() && *end == '\0' && std::isfinite(*v);
+// The whole of [begin, end) is one finite number.
+bool ParseFinite(const char* begin, const char* end, double* v) {
+  const char* stop = nullptr;
+  *v = ParseDouble(begin, end, &stop);
+  return stop != begin && stop == end && std::isfinite(*v);
 }
 
 // "key=value" from a comment line (value up to the next space).
@@ -57,102 +58,124 @@ std::optional<GeodeticPoint> HeaderOrigin(const std::string& line) {
   return g;
 }
 
-// Column indices of the fields we read.
-struct Columns {
-  int t = 0, px = 1, py = 2, pz = 3, qx = 4, qy = 5, qz = 6, qw = 7;
-  int vx = -1, vy = -1, vz = -1;
-  size_t count = 8;
-};
-
 }  // namespace
 
-Trajectory ReadTrajectory(const std::string& path) {
-  gzFile f = gzopen(path.c_str(), "rb");
-  if (f == nullptr) throw InputError(path + ": cannot open trajectory file");
-  Trajectory traj;
-  traj.path = path;
-  Columns col;
-  bool header_seen = false, origin_seen = false;
-  std::string line;
+void TrajectoryReader::GzClose::operator()(gzFile_s* f) const { gzclose(f); }
+
+TrajectoryReader::TrajectoryReader(const std::string& path) : path_(path), file_(gzopen(path.c_str(), "rb")) {
+  if (file_ == nullptr) throw InputError(path + ": cannot open trajectory file");
+  has_pending_ = ReadRow(&pending_);
+  if (!has_pending_) throw InputError(path + ": no trajectory rows");
+}
+
+TrajectoryReader::~TrajectoryReader() = default;
+
+void TrajectoryReader::Fail(const std::string& why) const {
+  throw InputError(path_ + ":" + std::to_string(line_no_) + ": " + why);
+}
+
+bool TrajectoryReader::Next(TrajectorySample* sample) {
+  if (!has_pending_) return false;
+  TrajectorySample row;
+  while (ReadRow(&row)) {
+    if (row.t < pending_.t) Fail("time goes backwards");
+    if (row.t == pending_.t) {
+      pending_ = row;
+      continue;
+    }
+    *sample = pending_;
+    pending_ = row;
+    return true;
+  }
+  *sample = pending_;
+  has_pending_ = false;
+  return true;
+}
+
+bool TrajectoryReader::ReadRow(TrajectorySample* sample) {
   char buf[8192];
-  uint64_t line_no = 0;
-  auto fail = [&](const std::string& why) {
-    gzclose(f);
-    throw InputError(path + ":" + std::to_string(line_no) + ": " + why);
-  };
-  while (gzgets(f, buf, sizeof(buf)) != nullptr) {
-    line = buf;
+  while (gzgets(file_.get(), buf, sizeof(buf)) != nullptr) {
+    line_ = buf;
     // A line longer than the buffer arrives in pieces: join them.
-    while (!line.empty() && line.back() != '\n' && gzgets(f, buf, sizeof(buf)) != nullptr) line += buf;
-    ++line_no;
-    const size_t first = line.find_first_not_of(" \t\r\n");
+    while (!line_.empty() && line_.back() != '\n' && gzgets(file_.get(), buf, sizeof(buf)) != nullptr) line_ += buf;
+    ++line_no_;
+    const size_t first = line_.find_first_not_of(" \t\r\n");
     if (first == std::string::npos) continue;
-    if (line[first] == '#') {
-      if (!origin_seen) {
-        if (auto origin = HeaderOrigin(line)) {
-          traj.origin = origin;
-          origin_seen = true;
-          traj.mode = HeaderValue(line, "mode");
+    if (line_[first] == '#') {
+      if (!origin_) {
+        if (auto origin = HeaderOrigin(line_)) {
+          origin_ = origin;
+          mode_ = HeaderValue(line_, "mode");
         }
       }
       continue;
     }
-    std::vector<std::string> fields = Fields(line);
+    SplitFields(line_, &fields_);
+    if (fields_.empty()) Fail("expected " + std::to_string(col_.count) + " fields, got 0");  // commas only
+    auto parse = [&](size_t i, double* v) {
+      return ParseFinite(line_.data() + fields_[i].first, line_.data() + fields_[i].second, v);
+    };
     double first_value = 0.0;
-    if (!ParseFinite(fields[0], &first_value)) {
+    if (!parse(0, &first_value)) {
       // A CSV header row naming the columns.
-      if (header_seen || !traj.samples.empty()) fail("expected a row of numbers, got '" + fields[0] + "'");
+      auto field = [&](size_t i) { return line_.substr(fields_[i].first, fields_[i].second - fields_[i].first); };
+      if (header_seen_ || row_seen_) Fail("expected a row of numbers, got '" + field(0) + "'");
       std::map<std::string, int> index;
-      for (size_t i = 0; i < fields.size(); ++i) index[fields[i]] = static_cast<int>(i);
+      for (size_t i = 0; i < fields_.size(); ++i) index[field(i)] = static_cast<int>(i);
       auto need = [&](const char* name) {
         const auto it = index.find(name);
-        if (it == index.end()) fail(std::string("header lacks column '") + name + "'");
+        if (it == index.end()) Fail(std::string("header lacks column '") + name + "'");
         return it->second;
       };
-      col.t = need("t");
-      col.px = need("px");
-      col.py = need("py");
-      col.pz = need("pz");
-      col.qw = need("qw");
-      col.qx = need("qx");
-      col.qy = need("qy");
-      col.qz = need("qz");
+      col_.t = need("t");
+      col_.px = need("px");
+      col_.py = need("py");
+      col_.pz = need("pz");
+      col_.qw = need("qw");
+      col_.qx = need("qx");
+      col_.qy = need("qy");
+      col_.qz = need("qz");
       if (index.count("vx") && index.count("vy") && index.count("vz")) {
-        col.vx = index["vx"];
-        col.vy = index["vy"];
-        col.vz = index["vz"];
-        traj.has_velocity = true;
+        col_.vx = index["vx"];
+        col_.vy = index["vy"];
+        col_.vz = index["vz"];
+        has_velocity_ = true;
       }
-      col.count = fields.size();
-      header_seen = true;
+      col_.count = fields_.size();
+      header_seen_ = true;
       continue;
     }
-    if (fields.size() != col.count) {
-      fail("expected " + std::to_string(col.count) + " fields, got " + std::to_string(fields.size()));
+    if (fields_.size() != col_.count) {
+      Fail("expected " + std::to_string(col_.count) + " fields, got " + std::to_string(fields_.size()));
     }
-    std::vector<double> v(fields.size());
-    for (size_t i = 0; i < fields.size(); ++i) {
-      if (!ParseFinite(fields[i], &v[i])) fail("field " + std::to_string(i + 1) + " is not a finite number");
+    values_.resize(fields_.size());
+    for (size_t i = 0; i < fields_.size(); ++i) {
+      if (!parse(i, &values_[i])) Fail("field " + std::to_string(i + 1) + " is not a finite number");
     }
+    const std::vector<double>& v = values_;
     TrajectorySample s;
-    s.t = v[col.t];
-    s.p_w = Vec3(v[col.px], v[col.py], v[col.pz]);
-    const Quat q(v[col.qw], v[col.qx], v[col.qy], v[col.qz]);
-    if (q.norm() < 0.5 || q.norm() > 2.0) fail("quaternion is not a rotation (norm " + std::to_string(q.norm()) + ")");
+    s.t = v[col_.t];
+    s.p_w = Vec3(v[col_.px], v[col_.py], v[col_.pz]);
+    const Quat q(v[col_.qw], v[col_.qx], v[col_.qy], v[col_.qz]);
+    if (q.norm() < 0.5 || q.norm() > 2.0) Fail("quaternion is not a rotation (norm " + std::to_string(q.norm()) + ")");
     s.q_wb = q.normalized();
-    if (traj.has_velocity) s.v_w = Vec3(v[col.vx], v[col.vy], v[col.vz]);
-    if (!traj.samples.empty()) {
-      const double last = traj.samples.back().t;
-      if (s.t < last) fail("time goes backwards");
-      if (s.t == last) {
-        traj.samples.back() = s;
-        continue;
-      }
-    }
-    traj.samples.push_back(s);
+    if (has_velocity_) s.v_w = Vec3(v[col_.vx], v[col_.vy], v[col_.vz]);
+    *sample = s;
+    row_seen_ = true;
+    return true;
   }
-  gzclose(f);
-  if (traj.samples.empty()) throw InputError(path + ": no trajectory rows");
+  return false;
+}
+
+Trajectory ReadTrajectory(const std::string& path) {
+  TrajectoryReader reader(path);
+  Trajectory traj;
+  traj.path = path;
+  TrajectorySample s;
+  while (reader.Next(&s)) traj.samples.push_back(s);
+  traj.mode = reader.mode();
+  traj.origin = reader.origin();
+  traj.has_velocity = reader.has_velocity();
   return traj;
 }
 
@@ -169,10 +192,14 @@ void ChangeFrame(const LocalEnuFrame& from, const LocalEnuFrame& to, Trajectory*
   trajectory->origin = to.origin();
 }
 
+TrajectorySample ToTrajectorySample(const TruthSample& truth) {
+  return {truth.t, truth.p_w, truth.q_wb, truth.v_w};
+}
+
 std::vector<TrajectorySample> ToTrajectorySamples(const std::vector<TruthSample>& truth) {
   std::vector<TrajectorySample> out;
   out.reserve(truth.size());
-  for (const TruthSample& s : truth) out.push_back({s.t, s.p_w, s.q_wb, s.v_w});
+  for (const TruthSample& s : truth) out.push_back(ToTrajectorySample(s));
   return out;
 }
 

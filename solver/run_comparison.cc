@@ -3,6 +3,8 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <memory>
+#include <optional>
 #include <stdexcept>
 
 #include "core/trajectory_reader.h"
@@ -85,54 +87,122 @@ std::string StreamFile(const std::string& dir, const std::string& name) {
   return std::filesystem::exists(states, ec) ? states : (d / (name + ".tum")).string();
 }
 
+namespace {
+
+// The gap interpolated across for a trajectory file: a first pass over it for its median interval.
+double FileMaxGap(const std::string& path, double max_gap) {
+  TrajectoryReader reader(path);
+  IntervalMedian intervals;
+  TrajectorySample s;
+  while (reader.Next(&s)) intervals.Add(s.t);
+  return EffectiveMaxGap(intervals, max_gap);
+}
+
+struct Outcome {
+  std::string name;
+  std::optional<TrajectoryMetrics> metrics;
+  std::string error;  // why nothing could be evaluated, when !metrics
+};
+
+// Each of `names` (files in `files`) against one reference, in a single pass over the reference: every
+// estimate is read alongside from its own reader.
+std::vector<Outcome> EvaluateAgainst(const SampleSource& reference, bool reference_has_velocity,
+                                     const std::vector<std::string>& names,
+                                     const std::map<std::string, std::string>& files,
+                                     const std::map<std::string, double>& max_gaps, const MetricOptions& options) {
+  std::vector<std::unique_ptr<TrajectoryReader>> readers;
+  std::vector<TrajectoryEvaluator> evaluators;
+  evaluators.reserve(names.size());
+  for (const std::string& name : names) {
+    readers.push_back(std::make_unique<TrajectoryReader>(files.at(name)));
+    TrajectoryReader* reader = readers.back().get();
+    evaluators.emplace_back([reader](TrajectorySample* s) { return reader->Next(s); },
+                            reference_has_velocity && reader->has_velocity(), max_gaps.at(name), options);
+  }
+  TrajectorySample ref;
+  while (reference(&ref)) {
+    for (TrajectoryEvaluator& e : evaluators) e.AddReference(ref);
+  }
+  std::vector<Outcome> out;
+  for (size_t i = 0; i < names.size(); ++i) {
+    Outcome o;
+    o.name = names[i];
+    try {
+      o.metrics = evaluators[i].Metrics();
+    } catch (const std::invalid_argument& e) {
+      o.error = e.what();
+    }
+    out.push_back(o);
+  }
+  return out;
+}
+
+}  // namespace
+
 nlohmann::json CompareRunOutputs(const std::string& out_dir, const std::vector<std::string>& streams,
-                                 const std::vector<TruthSample>* truth, const std::vector<TimeWindow>& outages,
+                                 const TruthFile* truth, const std::vector<TimeWindow>& outages,
                                  double time_origin) {
   nlohmann::json j;
-  std::map<std::string, Trajectory> traj;
-  for (const std::string& name : streams) traj[name] = ReadTrajectory(StreamFile(out_dir, name));
   MetricOptions options;
   options.outages = outages;
-  if (truth != nullptr && !truth->empty()) {
-    const std::vector<TrajectorySample> ref = ToTrajectorySamples(*truth);
+  // In name order (eskf, smoother, smoother_online), which also breaks ties of best_horizontal.
+  std::map<std::string, std::string> files;
+  for (const std::string& name : streams) files[name] = StreamFile(out_dir, name);
+  std::vector<std::string> names, others;  // others: all but the ESKF
+  for (const auto& [name, file] : files) {
+    names.push_back(name);
+    if (name != "eskf") others.push_back(name);
+  }
+  // The outputs evaluated as estimates: all of them against the truth, the others against the ESKF.
+  const bool with_eskf = files.count("eskf") && !others.empty();
+  std::map<std::string, double> max_gaps;
+  for (const std::string& name : names) {
+    if (truth != nullptr || (with_eskf && name != "eskf")) max_gaps[name] = FileMaxGap(files.at(name), options.max_gap);
+  }
+  if (truth != nullptr) {
+    TruthReader reader(truth->path, truth->frame);
+    const SampleSource reference = [&reader](TrajectorySample* s) {
+      TruthSample x;
+      if (!reader.Next(&x)) return false;
+      *s = ToTrajectorySample(x);
+      return true;
+    };
     double best = 0.0;
-    for (const auto& [name, t] : traj) {
-      try {
-        const TrajectoryMetrics m = EvaluateTrajectory(ref, true, t.samples, t.has_velocity, options);
-        j["vs_truth"][name] = MetricsToJson(m, time_origin);
-        // The causal smoother output is not a competitor of the final one: rank the estimators' main outputs.
-        if (name != "smoother_online" && (!j.contains("best_horizontal") || m.rmse_h < best)) {
-          best = m.rmse_h;
-          j["best_horizontal"] = name;
-        }
-      } catch (const std::invalid_argument& e) {
-        j["vs_truth"][name] = {{"error", e.what()}};
+    for (const Outcome& o : EvaluateAgainst(reference, true, names, files, max_gaps, options)) {
+      if (!o.metrics) {
+        j["vs_truth"][o.name] = {{"error", o.error}};
+        continue;
+      }
+      j["vs_truth"][o.name] = MetricsToJson(*o.metrics, time_origin);
+      // The causal smoother output is not a competitor of the final one: rank the estimators' main outputs.
+      if (o.name != "smoother_online" && (!j.contains("best_horizontal") || o.metrics->rmse_h < best)) {
+        best = o.metrics->rmse_h;
+        j["best_horizontal"] = o.name;
       }
     }
   }
-  const auto eskf = traj.find("eskf");
-  if (eskf != traj.end()) {
+  if (with_eskf) {
+    TrajectoryReader eskf(files.at("eskf"));
+    const SampleSource reference = [&eskf](TrajectorySample* s) { return eskf.Next(s); };
     MetricOptions diff;  // differences over the whole run, outages included
     diff.outages = outages;
-    for (const auto& [name, t] : traj) {
-      if (name == "eskf") continue;
-      try {
-        const TrajectoryMetrics m =
-            EvaluateTrajectory(eskf->second.samples, eskf->second.has_velocity, t.samples, t.has_velocity, diff);
-        nlohmann::json d;
-        d["samples"] = m.samples;
-        d["rms_horizontal_difference_m"] = m.rmse_h;
-        d["max_horizontal_difference_m"] = m.max_h;
-        d["max_horizontal_difference_time_s"] = m.t_max_h - time_origin;
-        d["rms_vertical_difference_m"] = m.rmse_v;
-        d["rms_heading_difference_deg"] = m.rmse_heading_deg;
-        d["rms_attitude_difference_deg"] = m.rmse_att_deg;
-        if (m.rmse_vel) d["rms_velocity_difference_m_s"] = *m.rmse_vel;
-        if (m.outages_scored) d["largest_horizontal_difference_in_outages_m"] = m.outage_max;
-        j[name + "_vs_eskf"] = d;
-      } catch (const std::invalid_argument& e) {
-        j[name + "_vs_eskf"] = {{"error", e.what()}};
+    for (const Outcome& o : EvaluateAgainst(reference, eskf.has_velocity(), others, files, max_gaps, diff)) {
+      if (!o.metrics) {
+        j[o.name + "_vs_eskf"] = {{"error", o.error}};
+        continue;
       }
+      const TrajectoryMetrics& m = *o.metrics;
+      nlohmann::json d;
+      d["samples"] = m.samples;
+      d["rms_horizontal_difference_m"] = m.rmse_h;
+      d["max_horizontal_difference_m"] = m.max_h;
+      d["max_horizontal_difference_time_s"] = m.t_max_h - time_origin;
+      d["rms_vertical_difference_m"] = m.rmse_v;
+      d["rms_heading_difference_deg"] = m.rmse_heading_deg;
+      d["rms_attitude_difference_deg"] = m.rmse_att_deg;
+      if (m.rmse_vel) d["rms_velocity_difference_m_s"] = *m.rmse_vel;
+      if (m.outages_scored) d["largest_horizontal_difference_in_outages_m"] = m.outage_max;
+      j[o.name + "_vs_eskf"] = d;
     }
   }
   return j;

@@ -25,11 +25,20 @@ std::vector<TimeWindow> OutageWindowsFromSummary(const nlohmann::json& summary);
 // else <name>.tum.
 std::string StreamFile(const std::string& dir, const std::string& name);
 
+// A run's truth file, read in the run's world frame.
+struct TruthFile {
+  std::string path;
+  LocalEnuFrame frame;
+};
+
 // After a run, from the committed outputs in `out_dir` (all in the run's world frame): each stream against
 // the truth (when given) with drift over `outages`, and the other streams' differences from the ESKF when
 // it ran. Returns {"vs_truth": {name: metrics}, "<name>_vs_eskf": {...}, "best_horizontal": name}.
+// Every file is streamed (TrajectoryEvaluator), so memory does not grow with the run's length: a first pass
+// over each output for its median interval, then one pass over the truth with every output read alongside,
+// and one over the ESKF's output with the others alongside.
 nlohmann::json CompareRunOutputs(const std::string& out_dir, const std::vector<std::string>& streams,
-                                 const std::vector<TruthSample>* truth, const std::vector<TimeWindow>& outages,
+                                 const TruthFile* truth, const std::vector<TimeWindow>& outages,
                                  double time_origin);
 
 }  // namespace gins

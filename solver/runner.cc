@@ -4,6 +4,7 @@
 #include <chrono>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "core/geodesy.h"
 #include "core/log_reader.h"
@@ -24,11 +25,17 @@ double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).coun
 // trajectory header needs the world frame's origin.
 class OutputStream {
  public:
-  OutputStream(const std::string& name, const std::string& dir, const GeodeticPoint& origin, bool with_states,
-               const std::vector<TruthSample>* truth)
-      : name_(name), tum_(dir + "/" + name + ".tum", name, origin) {
-    if (with_states) states_ = std::make_unique<StatesCsvWriter>(dir + "/" + name + "_states.csv", name, origin);
-    if (truth != nullptr) evaluator_ = std::make_unique<StreamingEvaluator>(*truth);
+  OutputStream(const std::string& name, const std::string& dir, const LocalEnuFrame& frame, bool with_states,
+               const std::optional<std::string>& truth_path)
+      : name_(name), tum_(dir + "/" + name + ".tum", name, frame.origin()) {
+    if (with_states) {
+      states_ = std::make_unique<StatesCsvWriter>(dir + "/" + name + "_states.csv", name, frame.origin());
+    }
+    if (truth_path) {
+      // Its own reader: the truth is pulled as this stream's states advance, never held whole.
+      truth_ = std::make_unique<TruthReader>(*truth_path, frame);
+      evaluator_ = std::make_unique<StreamingEvaluator>([r = truth_.get()](TruthSample* s) { return r->Next(s); });
+    }
   }
 
   void Add(const StateEstimate& e) {
@@ -62,6 +69,7 @@ class OutputStream {
   std::string name_;
   TumWriter tum_;
   std::unique_ptr<StatesCsvWriter> states_;
+  std::unique_ptr<TruthReader> truth_;
   std::unique_ptr<StreamingEvaluator> evaluator_;
   uint64_t non_finite_ = 0;
   double last_t_ = -1e300;
@@ -89,16 +97,22 @@ RunResult Run(const Options& options, const RunRequest& request) {
   if (ec) throw std::runtime_error(request.out_dir + ": cannot create output directory: " + ec.message());
 
   Session session(options);
-  std::vector<TruthSample> truth;
+  bool truth_checked = false;
   std::map<std::string, std::unique_ptr<OutputStream>> streams;
   // States arrive only after initialisation, when the world frame (and so the truth in it) exists.
   auto stream_callback = [&](const std::string& name, bool with_states) {
     return [&, name, with_states](const StateEstimate& e) {
       auto& s = streams[name];
       if (!s) {
-        if (request.truth_path && truth.empty()) truth = ReadTruth(*request.truth_path, *session.frame());
-        s = std::make_unique<OutputStream>(name, request.out_dir, session.frame()->origin(), with_states,
-                                           request.truth_path ? &truth : nullptr);
+        if (request.truth_path && !truth_checked) {
+          // Read through once now, so that a damaged truth stops the run here and not hours later.
+          TruthReader reader(*request.truth_path, *session.frame());
+          TruthSample x;
+          while (reader.Next(&x)) {
+          }
+          truth_checked = true;
+        }
+        s = std::make_unique<OutputStream>(name, request.out_dir, *session.frame(), with_states, request.truth_path);
       }
       s->Add(e);
     };
@@ -203,11 +217,15 @@ RunResult Run(const Options& options, const RunRequest& request) {
   j["gnss_gaps"] = session_stats["gnss_outages"]["log_gaps"];
   if (request.truth_path) j["truth"] = *request.truth_path;
   j["gnss_lever_arm_m"] = {options.gnss.lever_b.x(), options.gnss.lever_b.y(), options.gnss.lever_b.z()};
-  if (streams.size() > 1 || !truth.empty()) {
+  // Comparisons exist against the truth and against the ESKF: without either (the smoother alone) there
+  // is nothing to read back.
+  if (request.truth_path || (streams.count("eskf") && streams.size() > 1)) {
     std::vector<std::string> names;
     for (const auto& [name, s] : streams) names.push_back(name);
+    const std::optional<TruthFile> truth =
+        request.truth_path ? std::optional<TruthFile>(TruthFile{*request.truth_path, *session.frame()}) : std::nullopt;
     try {
-      j["comparison"] = CompareRunOutputs(request.out_dir, names, truth.empty() ? nullptr : &truth,
+      j["comparison"] = CompareRunOutputs(request.out_dir, names, truth ? &*truth : nullptr,
                                           OutageWindowsFromSummary(j), session.first_time());
     } catch (const std::exception& e) {
       j["comparison"] = {{"error", e.what()}};  // the outputs stand; only their comparison failed

@@ -234,6 +234,40 @@ TEST_F(CliRun, RunSmoother) {
   EXPECT_LT(acc["rmse_horizontal_m"].get<double>(), 0.05);
 }
 
+// Without a truth the smoother's two outputs have nothing to be compared with (comparisons are against
+// the truth or the ESKF): the run does not read them back.
+TEST_F(CliRun, RunSmootherWithoutTruthComparesNothing) {
+  ASSERT_EQ(sim_exit_, 0);
+  const std::string out = dir_ + "/out_smoother_no_truth";
+  ASSERT_EQ(RunCliInChild({"run", "--config", config_, "--log", log_, "--out", out, "--mode", "smoother"}), 0);
+  const nlohmann::json s = Summary(out);
+  EXPECT_FALSE(s.contains("comparison")) << s["comparison"].dump();
+  EXPECT_FALSE(s.contains("accuracy"));
+}
+
+// The truth streams in as the estimates advance, but it is read through once when the first state needs
+// it, so a damaged row near its end stops the run before the processing, naming file and line; no files.
+TEST_F(CliRun, DamagedTruthStopsTheRunAndNamesTheLine) {
+  ASSERT_EQ(sim_exit_, 0);
+  std::vector<std::string> lines = Lines(test::ReadFile(truth_));
+  ASSERT_GT(lines.size(), 100u);
+  const size_t bad = lines.size() - 10;  // 0-based: line bad + 1
+  lines[bad] = "1700000039.9,31.5,120.4,oops,1,0,0,0,0,0,0";
+  std::string text;
+  for (const auto& l : lines) text += l + "\n";
+  const std::string truth = dir_ + "/damaged_truth.csv";
+  test::WriteFile(truth, text);
+  const std::string out = dir_ + "/out_damaged_truth";
+  std::string err;
+  EXPECT_EQ(RunCliCapturingStderr({"run", "--config", config_, "--log", log_, "--out", out, "--mode", "both",
+                                   "--truth", truth},
+                                  dir_ + "/damaged_truth.err", &err),
+            1);
+  EXPECT_NE(err.find(truth + ":" + std::to_string(bad + 1) + ": truth row needs 11 numeric fields"), std::string::npos)
+      << err;
+  EXPECT_EQ(FilesIn(out), 0u);
+}
+
 TEST_F(CliRun, RunBoth) {
   ASSERT_EQ(sim_exit_, 0);
   const std::string out = dir_ + "/out_both";

@@ -290,6 +290,82 @@ TEST(ReadTruth, MalformedRowNamesFileAndLine) {
   ExpectInputErrorAt(dir + "/word.csv.gz", ":3:");
 }
 
+// The streaming reader: the same samples as ReadTruth (which collects it), rows not later than the
+// previous one dropped; a damaged row deep in the file surfaces when reached, naming file and line.
+TEST(TruthReader, StreamsWhatReadTruthReads) {
+  const LocalEnuFrame frame(kOrigin);
+  const std::string path = test::MakeTempDir("truth_stream") + "/truth.csv.gz";
+  std::vector<Row> rows = SampleRows();
+  rows.insert(rows.begin() + 2, rows[1]);  // a repeated time: dropped
+  WriteGzip(path, TruthCsv(frame, rows));
+  ASSERT_FALSE(HasFailure());
+  const std::vector<TruthSample> whole = ReadTruth(path, frame);
+  ASSERT_EQ(whole.size(), 3u);
+  TruthReader reader(path, frame);
+  EXPECT_EQ(reader.path(), path);
+  TruthSample s;
+  for (const TruthSample& w : whole) {
+    ASSERT_TRUE(reader.Next(&s));
+    EXPECT_EQ(s.t, w.t);
+    EXPECT_EQ(s.p_w, w.p_w);
+    EXPECT_EQ(s.q_wb.coeffs(), w.q_wb.coeffs());
+    EXPECT_EQ(s.v_w, w.v_w);
+  }
+  EXPECT_FALSE(reader.Next(&s));
+  EXPECT_FALSE(reader.Next(&s));
+}
+
+TEST(TruthReader, DamagedRowNamesFileAndLineWhenReached) {
+  const std::string dir = test::MakeTempDir("truth_stream_bad");
+  const std::string header = "t,lat,lon,alt,qw,qx,qy,qz,ve,vn,vu\n";
+  test::WriteFile(dir + "/late.csv", header + "1000.0,31.5,120.4,10,1,0,0,0,0,0,0\n" +
+                                         "1000.1,31.5,120.4,10,1,0,0,0,0,0,0\n" +
+                                         "1000.2,31.5,120.4,10,1,0,0,0,0,0,0,7\n");
+  TruthReader reader(dir + "/late.csv", LocalEnuFrame(kOrigin));
+  TruthSample s;
+  ASSERT_TRUE(reader.Next(&s));
+  ASSERT_TRUE(reader.Next(&s));
+  try {
+    reader.Next(&s);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(dir + "/late.csv:4: truth row has more than 11 fields"), std::string::npos)
+        << e.what();
+  }
+  test::WriteFile(dir + "/header_only.csv", header);
+  TruthReader empty(dir + "/header_only.csv", LocalEnuFrame(kOrigin));
+  EXPECT_THROW(empty.Next(&s), InputError);  // no truth rows
+  EXPECT_THROW(TruthReader(dir + "/none.csv", LocalEnuFrame(kOrigin)), InputError);
+}
+
+// The evaluator pulling its truth from a reader gives what it gives over the same truth in memory.
+TEST(StreamingEvaluator, PullsTruthFromAReader) {
+  const LocalEnuFrame frame(kOrigin);
+  const std::string path = test::MakeTempDir("truth_pull") + "/truth.csv";
+  std::vector<Row> rows;
+  for (int k = 0; k <= 80; ++k) {
+    const TruthSample s = TruthAt(kT0 + k * kTruthDt);
+    rows.push_back({s.t, s.p_w, s.q_wb, s.v_w});
+  }
+  test::WriteFile(path, TruthCsv(frame, rows));
+  TruthReader reader(path, frame);
+  StreamingEvaluator pulled([&reader](TruthSample* s) { return reader.Next(s); });
+  StreamingEvaluator held(ReadTruth(path, frame));
+  for (int k = 0; k <= 250; ++k) {
+    NavState x = EstimateFromTruth(kT0 - 0.5 + 0.04 * k);
+    x.p_wb.x() += 0.01 * k;
+    pulled.Add(x);
+    held.Add(x);
+  }
+  const AccuracyMetrics a = pulled.Metrics(), b = held.Metrics();
+  EXPECT_GT(a.count, 70u);
+  EXPECT_EQ(a.count, b.count);
+  EXPECT_EQ(a.rmse_3d, b.rmse_3d);
+  EXPECT_EQ(a.max_h, b.max_h);
+  EXPECT_EQ(a.rmse_vel, b.rmse_vel);
+  EXPECT_EQ(a.rmse_att_deg, b.rmse_att_deg);
+}
+
 TEST(ReadTruth, MissingOrEmptyFileThrows) {
   const std::string dir = test::MakeTempDir("truth_missing");
   EXPECT_THROW(ReadTruth(dir + "/none.csv", LocalEnuFrame(kOrigin)), InputError);

@@ -4,8 +4,11 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <random>
 #include <string>
+#include <vector>
 
 namespace gins {
 namespace {
@@ -67,6 +70,41 @@ TEST(NumberFormat, NonFiniteAndTooShortBuffers) {
   char buf[4];
   EXPECT_EQ(FormatFixed(buf, buf + sizeof(buf), 123.456, 2), buf);  // does not fit: nothing written
   EXPECT_EQ(FormatScientific(buf, buf + sizeof(buf), 123.456, 2), buf);
+}
+
+// ParseDouble is strtod on the range, value and end alike, for what from_chars takes and what it leaves to
+// strtod.
+TEST(ParseDouble, IsStrtodOnTheRange) {
+  std::vector<std::string> texts = {"0",        "1.5",      "-2.25e-3", "1700000002.000001", "12,3",   "  7",
+                                    "+4",       "0x1p3",    "-0X1.8p1", "1e",        "1e+",    "1.e5",
+                                    ".5",       "-.5e1",    "1e400",    "-1e400",    "1e-400", "4.9e-324",
+                                    "inf",      "-INF",     "nan",      "nan(123)",  "abc",    "",
+                                    "-",        "1.5 2.5",  "3\r\n",    "1..2",      "0.1e-5x", "\t8"};
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> mantissa(-10.0, 10.0);
+  std::uniform_int_distribution<int> exponent(-300, 300);
+  for (int i = 0; i < 2000; ++i) {
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), i % 2 ? "%.17g" : "%.6f", mantissa(rng) * std::pow(10.0, exponent(rng) / 10));
+    texts.push_back(buf);
+  }
+  for (const std::string& text : texts) {
+    char* want_end = nullptr;
+    const double want = std::strtod(text.c_str(), &want_end);
+    const char* end = nullptr;
+    const double got = ParseDouble(text.data(), text.data() + text.size(), &end);
+    EXPECT_EQ(end - text.data(), want_end - text.c_str()) << "'" << text << "'";
+    if (std::isnan(want)) {
+      EXPECT_TRUE(std::isnan(got)) << "'" << text << "'";
+    } else {
+      EXPECT_EQ(got, want) << "'" << text << "'";
+    }
+  }
+  // Only the range is read: a number cut short by `last`.
+  const char* text = "123.456";
+  const char* end = nullptr;
+  EXPECT_EQ(ParseDouble(text, text + 3, &end), 123.0);
+  EXPECT_EQ(end, text + 3);
 }
 
 }  // namespace

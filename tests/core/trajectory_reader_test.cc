@@ -1,5 +1,6 @@
 // Reading trajectories back (core/trajectory_reader.h): what TumWriter and StatesCsvWriter write reads back,
-// foreign TUM files, gzip, malformed files, and re-expressing a trajectory in another ENU frame.
+// foreign TUM files, gzip, malformed files (whole and streamed), and re-expressing a trajectory in another
+// ENU frame.
 #include "core/trajectory_reader.h"
 
 #include <gtest/gtest.h>
@@ -113,6 +114,76 @@ TEST(ReadTrajectory, MalformedFilesNameFileAndLine) {
   ExpectInputError(d + "/f.tum", "1 0 0 0 0 0 0 0\n", "quaternion is not a rotation");
   ExpectInputError(d + "/g.csv", "t,x,y\n1,2,3\n", d + "/g.csv:1: header lacks column 'px'");
   EXPECT_THROW(ReadTrajectory(d + "/missing.tum"), InputError);
+}
+
+// The streaming reader hands out what ReadTrajectory collects, with the header known from the start.
+TEST(TrajectoryReader, StreamsWhatReadTrajectoryReads) {
+  const std::string dir = test::MakeTempDir("traj_stream");
+  {
+    StatesCsvWriter csv(dir + "/eskf_states.csv", "eskf", kOrigin);
+    for (const NavState& x : States()) csv.Add(x, Vec3::Constant(0.1), Vec3::Constant(0.2), Vec3::Constant(0.3), 1.0);
+    csv.Commit();
+  }
+  WriteGzip(dir + "/foreign.tum.gz", "# t x y z qx qy qz qw\n1 0 0 0 0 0 0 1\n2 1 0 0 0 0 0 1\n2 5 0 0 0 0 0 1\n");
+  for (const char* file : {"/eskf_states.csv", "/foreign.tum.gz"}) {
+    SCOPED_TRACE(file);
+    const Trajectory whole = ReadTrajectory(dir + file);
+    TrajectoryReader reader(dir + file);
+    EXPECT_EQ(reader.path(), dir + file);
+    EXPECT_EQ(reader.mode(), whole.mode);
+    EXPECT_EQ(reader.origin().has_value(), whole.origin.has_value());
+    EXPECT_EQ(reader.has_velocity(), whole.has_velocity);
+    TrajectorySample s;
+    size_t n = 0;
+    while (reader.Next(&s)) {
+      ASSERT_LT(n, whole.samples.size());
+      EXPECT_EQ(s.t, whole.samples[n].t);
+      EXPECT_EQ(s.p_w, whole.samples[n].p_w);  // the repeated time: the later row
+      EXPECT_EQ(s.v_w, whole.samples[n].v_w);
+      EXPECT_EQ(s.q_wb.coeffs(), whole.samples[n].q_wb.coeffs());
+      ++n;
+    }
+    EXPECT_EQ(n, whole.samples.size());
+    EXPECT_FALSE(reader.Next(&s));  // stays at the end
+  }
+}
+
+// A damaged row deep in a file: the rows before it stream out, then the error names file and line.
+TEST(TrajectoryReader, ErrorsNameFileAndLineWhenReached) {
+  const std::string d = test::MakeTempDir("traj_stream_bad");
+  auto rows_then_throw = [](const std::string& path, const std::string& text, size_t good, const std::string& what) {
+    test::WriteFile(path, text);
+    TrajectoryReader reader(path);
+    TrajectorySample s;
+    for (size_t i = 0; i < good; ++i) ASSERT_TRUE(reader.Next(&s)) << i;
+    try {
+      reader.Next(&s);
+      FAIL() << "no error for " << path;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  const std::string rows = "1 0 0 0 0 0 0 1\n# a comment\n2 0 0 0 0 0 0 1\n3 0 0 0 0 0 0 1\n";
+  // The row before the damaged one is handed out once the damaged one is read: two of the three.
+  rows_then_throw(d + "/a.tum", rows + "4 0 x 0 0 0 0 1\n", 2, d + "/a.tum:5: field 3 is not a finite number");
+  rows_then_throw(d + "/b.tum", rows + "2.5 0 0 0 0 0 0 1\n", 2, d + "/b.tum:5: time goes backwards");
+  rows_then_throw(d + "/c.tum", rows + ",, ,\n", 2, d + "/c.tum:5: expected 8 fields, got 0");
+  rows_then_throw(d + "/d.csv", "t,px,py,pz,qw,qx,qy,qz\n1,0,0,0,1,0,0,0\n2,0,0,0,1,0,0,0\nt,px\n", 1,
+                  d + "/d.csv:4: expected a row of numbers, got 't'");
+  // The first row, an empty or a missing file: already the constructor.
+  auto construct_throws = [](const std::string& path, const std::string& what) {
+    try {
+      TrajectoryReader reader(path);
+      FAIL() << "no error for " << path;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  test::WriteFile(d + "/e.tum", "# header\n1 0 0 0 0 0 0 nan\n");
+  construct_throws(d + "/e.tum", d + "/e.tum:2: field 8 is not a finite number");
+  test::WriteFile(d + "/f.tum", "# only a comment\n");
+  construct_throws(d + "/f.tum", d + "/f.tum: no trajectory rows");
+  construct_throws(d + "/missing.tum", d + "/missing.tum: cannot open trajectory file");
 }
 
 // Two ENU frames 3 km apart: the same geodetic points, expressed in either, map onto each other exactly.

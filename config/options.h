@@ -106,9 +106,9 @@ struct SmootherOptions {
   int window_size = 10;             // smoother.window_size: keyframes in the window
   double max_keyframe_interval = 1.0;  // smoother.max_keyframe_interval_s
   double min_keyframe_interval = 0.5;  // smoother.min_keyframe_interval_s: faster GNSS is decimated
-  std::string linear_solver = "dense_schur";  // smoother.linear_solver: dense_schur | sparse_normal_cholesky
+  std::string linear_solver = "sparse_normal_cholesky";  // smoother.linear_solver: sparse_normal_cholesky | dense_schur
   int max_iterations = 10;          // smoother.max_iterations
-  double function_tolerance = 1e-3;  // smoother.function_tolerance: stop when |Δcost|/cost falls below
+  double function_tolerance = 1e-6;  // smoother.function_tolerance: stop when |Δcost|/cost falls below
   int num_threads = 1;              // smoother.num_threads
   double gnss_loss_scale = 3.0;     // smoother.gnss_loss_scale: Cauchy loss scale on whitened residuals
   double bias_reintegrate_threshold = 1e-3;  // smoother.bias_reintegrate_threshold (norm of δb)

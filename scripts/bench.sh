@@ -3,10 +3,7 @@
 # the benchmark binary (e.g. --benchmark_filter=Eskf --benchmark_repetitions=5).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/install_deps.sh
-dpkg-query -W -f='${Status}' libbenchmark-dev 2>/dev/null | grep -q "install ok installed" || {
-  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libbenchmark-dev >/dev/null
-}
+./scripts/install_deps.sh libbenchmark-dev
 cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DGINS_BUILD_TESTS=OFF -DGINS_BUILD_BENCHMARKS=ON >/dev/null
 cmake --build build-bench --target gins_bench -j"$(nproc)"
 ./build-bench/tests/bench/gins_bench "$@"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Installs the Debian packages gins needs that are not installed yet (run as root on Debian 12).
+# Installs the Debian packages gins needs that are not installed yet (run as root on Debian 12). Extra
+# arguments are further packages wanted (the benchmark scripts add libbenchmark-dev and time).
 set -euo pipefail
-packages=(
+packages=("$@"
   build-essential cmake pkg-config
   libeigen3-dev libceres-dev libsuitesparse-dev libgoogle-glog-dev libyaml-cpp-dev
   libgeographiclib-dev libcli11-dev nlohmann-json3-dev zlib1g-dev

@@ -100,9 +100,14 @@ struct Smoother::Keyframe {
 // only between solves (in MarginalizeOldest), never while Ceres evaluates.
 class Smoother::FejCost final : public ceres::CostFunction {
  public:
-  // owners[i]: the keyframe of parameter block i and that block's first-estimate storage. (Ceres passes
-  // its own copies of the parameters to Evaluate, so blocks cannot be recognised by address there.)
-  FejCost(ceres::CostFunction* inner, std::vector<std::pair<const Keyframe*, const double*>> owners)
+  // owners[i]: parameter block i's keyframe and first-estimate storage. (Ceres passes its own copies of the
+  // parameters to Evaluate, so blocks cannot be recognised by address there.)
+  struct Owner {
+    const Keyframe* kf = nullptr;
+    const double* first_estimate = nullptr;
+    bool is_pose = false;
+  };
+  FejCost(ceres::CostFunction* inner, std::vector<Owner> owners)
       : inner_(inner), owners_(std::move(owners)) {
     set_num_residuals(inner_->num_residuals());
     *mutable_parameter_block_sizes() = inner_->parameter_block_sizes();
@@ -115,28 +120,45 @@ class Smoother::FejCost final : public ceres::CostFunction {
     bool substituted = false;
     for (size_t i = 0; i < n; ++i) {
       at[i] = parameters[i];
-      if (owners_[i].first != nullptr && owners_[i].first->fej) {
-        at[i] = owners_[i].second;
+      if (owners_[i].kf != nullptr && owners_[i].kf->fej) {
+        at[i] = owners_[i].first_estimate;
         substituted = true;
       }
     }
     if (!substituted) return inner_->Evaluate(parameters, residuals, jacobians);
     if (!inner_->Evaluate(parameters, residuals, nullptr)) return false;
     std::array<double, 16> scratch;
-    return inner_->Evaluate(at.data(), scratch.data(), jacobians);
+    if (!inner_->Evaluate(at.data(), scratch.data(), jacobians)) return false;
+    // Ceres turns an ambient pose Jacobian into a tangent one with PlusJacobian at the CURRENT value; the
+    // first-estimate Jacobian is tangent at the first estimate. Re-express it so that Ceres's product gives
+    // exactly that: J_tan = J_amb(x_fej)·Plus'(x_fej), then J_amb' = J_tan·Minus'(x) (Minus'·Plus' = I).
+    for (size_t i = 0; i < n; ++i) {
+      if (at[i] == parameters[i] || jacobians[i] == nullptr || !owners_[i].is_pose) continue;
+      using Mat76 = Eigen::Matrix<double, pose::kAmbient, pose::kTangent, Eigen::RowMajor>;
+      using Mat67 = Eigen::Matrix<double, pose::kTangent, pose::kAmbient, Eigen::RowMajor>;
+      Mat76 plus_fej;
+      Mat67 minus_now;
+      manifold_.PlusJacobian(at[i], plus_fej.data());
+      manifold_.MinusJacobian(parameters[i], minus_now.data());
+      using JacobianMap = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, pose::kAmbient, Eigen::RowMajor>>;
+      JacobianMap J(jacobians[i], num_residuals(), pose::kAmbient);
+      J = (J * plus_fej * minus_now).eval();
+    }
+    return true;
   }
 
  private:
   std::unique_ptr<ceres::CostFunction> inner_;
-  std::vector<std::pair<const Keyframe*, const double*>> owners_;
+  std::vector<Owner> owners_;
+  PoseManifold manifold_;
 };
 
 ceres::ResidualBlockId Smoother::AddFactor(ceres::CostFunction* cost, ceres::LossFunction* loss,
                                            const std::vector<std::pair<const Keyframe*, double*>>& blocks) {
-  std::vector<std::pair<const Keyframe*, const double*>> owners;
+  std::vector<FejCost::Owner> owners;
   std::vector<double*> params;
   for (const auto& [kf, block] : blocks) {
-    owners.emplace_back(kf, kf->FirstEstimate(block));
+    owners.push_back({kf, kf->FirstEstimate(block), block == kf->pose});
     params.push_back(block);
   }
   CHECK_LE(owners.size(), 8u);
@@ -553,6 +575,10 @@ bool Smoother::Solve() {
   ceres::Solver::Options so;
   so.linear_solver_type = options_.smoother.linear_solver == "sparse_normal_cholesky" ? ceres::SPARSE_NORMAL_CHOLESKY
                                                                                       : ceres::DENSE_SCHUR;
+  // SuiteSparse when Ceres has it (Debian's does), Eigen's sparse Cholesky otherwise.
+  if (!ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)) {
+    so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
+  }
   so.max_num_iterations = options_.smoother.max_iterations;
   so.function_tolerance = options_.smoother.function_tolerance;
   so.num_threads = options_.smoother.num_threads;

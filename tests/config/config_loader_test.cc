@@ -226,7 +226,7 @@ Options NonDefaultOptions() {
   o.smoother.window_size = 20;
   o.smoother.max_keyframe_interval = 0.5;
   o.smoother.min_keyframe_interval = 0.25;
-  o.smoother.linear_solver = "sparse_normal_cholesky";
+  o.smoother.linear_solver = "dense_schur";
   o.smoother.max_iterations = 4;
   o.smoother.num_threads = 4;
   o.smoother.gnss_loss_scale = 1.5;
@@ -468,11 +468,11 @@ TEST(ConfigLoaderTest, ZeroDisablesGates) {
 TEST(ConfigLoaderTest, EnumsAndBooleans) {
   const Options o = Load(
       "input: {on_error: stop}\ngravity: {model: fixed, magnitude_m_s2: 9.8}\n"
-      "smoother: {linear_solver: sparse_normal_cholesky}\nwheel: {enabled: false, nonholonomic: true}");
+      "smoother: {linear_solver: dense_schur}\nwheel: {enabled: false, nonholonomic: true}");
   EXPECT_EQ(o.input.on_error, InputErrorPolicy::kStop);
   EXPECT_FALSE(o.gravity.use_normal_gravity);
   EXPECT_EQ(o.gravity.magnitude, 9.8);
-  EXPECT_EQ(o.smoother.linear_solver, "sparse_normal_cholesky");
+  EXPECT_EQ(o.smoother.linear_solver, "dense_schur");
   EXPECT_FALSE(o.wheel.enabled);
   EXPECT_TRUE(o.wheel.nonholonomic);
 }

@@ -52,8 +52,11 @@ void Preintegration::Step(const Sample& s) {
   Mat6 Q = ImuDiscreteNoise(gyro_noise_density_, acc_noise_density_, s.dt);
   Q.diagonal().head<3>().array() += s.held_gyro_sigma * s.held_gyro_sigma;
   Q.diagonal().tail<3>().array() += s.held_acc_sigma * s.held_acc_sigma;
-  cov_ = J.A * cov_ * J.A.transpose() + J.B * Q * J.B.transpose();
-  J_bias_ = J.A * J_bias_ + J.B;
+  // The kernel's structured products (MulA, MulBG): A and B are mostly zero and identity blocks.
+  const Mat9 A_cov = MulA<9>(J, cov_);
+  const Eigen::Matrix<double, 9, 6> BQ = J.B.lazyProduct(Q);
+  cov_ = MulA<9>(J, Mat9(A_cov.transpose())).transpose() + BQ.lazyProduct(J.B.transpose());
+  J_bias_ = MulA<6>(J, J_bias_) + J.B;
   delta_.dq = y.q;
   delta_.dv = y.v;
   delta_.dp = y.p;

@@ -63,7 +63,7 @@ for mode in eskf smoother both; do
 import json, sys
 t = json.load(open(sys.argv[1]))["trajectories"]
 cell = lambda key, fmt: " / ".join(fmt.format(x[key]) for x in t)
-print("|".join([cell("rmse_horizontal_m", "{:.3f} m"), cell("rmse_heading_deg", "{:.3f}°"),
+print(" | ".join([cell("rmse_horizontal_m", "{:.3f} m"), cell("rmse_heading_deg", "{:.3f}°"),
                 cell("outage_drift_max_m", "{:.2f} m")]))
 PY
 )

@@ -29,11 +29,11 @@ constexpr double kZeroRateGateProbability = 0.9999;  // the gyro-reads-its-bias 
 constexpr double kResetPosSigma = 1.0;  // m
 constexpr double kResetVelSigma = 1.0;  // m/s
 constexpr double kResetMaxFixInterval = 2.0;  // s
-constexpr int kResetMinRejects = 3;
 
 }  // namespace
 
-Eskf::Eskf(const Options& options, StateCallback on_state) : options_(options), on_state_(std::move(on_state)) {
+Eskf::Eskf(const Options& options, StateCallback on_state)
+    : options_(options), on_state_(std::move(on_state)), watchdog_(options.watchdog) {
   gate_gnss_ = GateFor(options_.gnss.gate_probability, 3);
   gate_heading_ = GateFor(options_.gnss.gate_probability, 1);
   gate_wheel_ = GateFor(options_.wheel.gate_probability, 1);
@@ -58,8 +58,7 @@ void Eskf::Initialize(const InitResult& init) {
   gyro_sum_.setZero();
   gyro_count_ = 0;
   gyro_sum_start_ = x_.t;
-  first_reject_t_ = -1.0;
-  rejects_since_accept_ = 0;
+  watchdog_.Clear();
   initialized_ = true;
   if (on_state_) on_state_(Estimate());
 }
@@ -309,17 +308,7 @@ void Eskf::AddStandstill(const StandstillMeasurement& m) {
 }
 
 bool Eskf::WatchGnss(const GnssMeasurement& m, bool accepted) {
-  if (accepted) {
-    first_reject_t_ = -1.0;
-    rejects_since_accept_ = 0;
-    return false;
-  }
-  if (first_reject_t_ < 0.0) first_reject_t_ = m.t;
-  ++rejects_since_accept_;
-  if (!options_.watchdog.enabled || rejects_since_accept_ < kResetMinRejects ||
-      m.t - first_reject_t_ < options_.watchdog.max_reject) {
-    return false;
-  }
+  if (!watchdog_.Watch(m.t, accepted)) return false;
   ResetFromGnss(m, "gnss_rejected");
   return true;
 }
@@ -370,9 +359,7 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
   gyro_sum_.setZero();
   gyro_count_ = 0;
   gyro_sum_start_ = m.t;
-  first_reject_t_ = -1.0;
-  rejects_since_accept_ = 0;
-  if (resets_.size() < kMaxListed) resets_.push_back({m.t, reason});
+  watchdog_.Reset(m.t, reason);
   LOG(WARNING) << "eskf watchdog: re-initialised from GNSS at t=" << std::fixed << m.t << " (" << reason
                << (have_velocity ? "; velocity from the last two fixes" : "; velocity kept") << ")";
   if (on_state_) on_state_(Estimate());
@@ -395,9 +382,7 @@ nlohmann::json Eskf::Stats() const {
   j["imu_gaps"] = imu_gaps_;
   j["imu_gap_times"] = nlohmann::json::array();
   for (const auto& [a, b] : gap_times_) j["imu_gap_times"].push_back({a, b});
-  nlohmann::json resets = nlohmann::json::array();
-  for (const Reset& r : resets_) resets.push_back({{"time", r.t}, {"reason", r.reason}});
-  j["watchdog"] = {{"resets", resets}, {"count", resets_.size()}};
+  j["watchdog"] = watchdog_.ToJson();
   j["gnss_position"] = gnss_counts_.ToJson();
   j["gnss_heading"] = heading_counts_.ToJson();
   j["wheel"] = wheel_counts_.ToJson();

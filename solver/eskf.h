@@ -91,14 +91,7 @@ class Eskf : public Estimator {
   std::vector<std::pair<double, double>> gap_times_;  // first few IMU gaps: [last sample, next sample]
   MeasurementCounts gnss_counts_, heading_counts_, wheel_counts_, zupt_counts_;
 
-  // Watchdog state.
-  struct Reset {
-    double t;
-    std::string reason;
-  };
-  std::vector<Reset> resets_;
-  double first_reject_t_ = -1.0;  // first rejected fix since the last accepted one (< 0: none)
-  int rejects_since_accept_ = 0;
+  GnssWatchdog watchdog_;
   std::optional<GnssMeasurement> prev_fix_;  // the fix before the current one, accepted or not
 };
 

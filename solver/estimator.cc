@@ -20,4 +20,26 @@ nlohmann::json MeasurementCounts::ToJson() const {
   return j;
 }
 
+bool GnssWatchdog::Watch(double t, bool accepted) {
+  if (accepted) {
+    Clear();
+    return false;
+  }
+  if (first_reject_t_ < 0.0) first_reject_t_ = t;
+  ++rejects_;
+  return options_.enabled && rejects_ >= kMinRejects && t - first_reject_t_ >= options_.max_reject;
+}
+
+void GnssWatchdog::Reset(double t, const std::string& reason) {
+  Clear();
+  ++count_;
+  if (resets_.size() < kMaxListedTimes) resets_.push_back({t, reason});
+}
+
+nlohmann::json GnssWatchdog::ToJson() const {
+  nlohmann::json resets = nlohmann::json::array();
+  for (const Event& r : resets_) resets.push_back({{"time", r.t}, {"reason", r.reason}});
+  return {{"resets", resets}, {"count", count_}};
+}
+
 }  // namespace gins

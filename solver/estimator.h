@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "config/options.h"
 #include "core/measurements.h"
 #include "core/nav_state.h"
 #include "core/static_init.h"
@@ -32,6 +33,32 @@ struct MeasurementCounts {
   std::vector<double> rejected_times;  // first few, for the summary
   void Reject(const std::string& reason, double t);
   nlohmann::json ToJson() const;
+};
+
+// The watchdog's bookkeeping, alike in both estimators: how long every GNSS fix has been rejected, and the
+// re-initialisations so far (listed in the summary). What a re-initialisation does is each estimator's own.
+class GnssWatchdog {
+ public:
+  explicit GnssWatchdog(const WatchdogOptions& options) : options_(options) {}
+  // One fix's outcome. True when the estimator should re-initialise from GNSS: at least kMinRejects fixes
+  // in a row rejected, over at least watchdog.max_reject_s (and the watchdog enabled).
+  bool Watch(double t, bool accepted);
+  // A re-initialisation at t happened: the rejection streak starts again.
+  void Reset(double t, const std::string& reason);
+  void Clear() { first_reject_t_ = -1.0, rejects_ = 0; }
+  nlohmann::json ToJson() const;  // {"resets": [{"time", "reason"}...], "count"}
+
+ private:
+  static constexpr int kMinRejects = 3;
+  struct Event {
+    double t;
+    std::string reason;
+  };
+  WatchdogOptions options_;
+  double first_reject_t_ = -1.0;  // first rejected fix since the last accepted one (< 0: none)
+  int rejects_ = 0;
+  std::vector<Event> resets_;     // the first few
+  uint64_t count_ = 0;
 };
 
 class Estimator {

@@ -5,6 +5,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -40,7 +41,6 @@ constexpr size_t kMaxListed = 100;
 constexpr double kResetPosSigma = 1.0;        // m, added to the fix's σ
 constexpr double kResetVelSigma = 1.0;        // m/s
 constexpr double kResetMaxFixInterval = 2.0;  // s
-constexpr int kResetMinRejects = 3;
 
 // Tangent layout of one keyframe in covariance blocks: pose (δp, δθ), vel (δv), bias (δbg, δba).
 // NavState tangent order is δp, δv, δθ, δbg, δba; this maps keyframe-tangent index -> NavState index.
@@ -167,7 +167,8 @@ ceres::ResidualBlockId Smoother::AddFactor(ceres::CostFunction* cost, ceres::Los
 }
 
 Smoother::Smoother(const Options& options, StateCallback on_final, StateCallback on_online)
-    : options_(options), on_final_(std::move(on_final)), on_online_(std::move(on_online)) {
+    : options_(options), on_final_(std::move(on_final)), on_online_(std::move(on_online)),
+      watchdog_(options.watchdog) {
   gnss_gate_ = options_.gnss.gate_probability > 0.0 ? Chi2Quantile(options_.gnss.gate_probability, 3)
                                                     : std::numeric_limits<double>::infinity();
   zupt_gate_ = options_.wheel.gate_probability > 0.0 ? Chi2Quantile(options_.wheel.gate_probability, 3)
@@ -487,17 +488,7 @@ void Smoother::AddGnss(const GnssMeasurement& m) {
 }
 
 void Smoother::WatchGnss(double t, bool accepted) {
-  if (accepted) {
-    first_reject_t_ = -1.0;
-    rejects_since_accept_ = 0;
-    return;
-  }
-  if (first_reject_t_ < 0.0) first_reject_t_ = t;
-  ++rejects_since_accept_;
-  if (options_.watchdog.enabled && rejects_since_accept_ >= kResetMinRejects &&
-      t - first_reject_t_ >= options_.watchdog.max_reject) {
-    reset_reason_ = "gnss_rejected";
-  }
+  if (watchdog_.Watch(t, accepted)) reset_reason_ = "gnss_rejected";
 }
 
 void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason_in) {
@@ -562,11 +553,9 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
   last_imu_ = last_imu;
   last_wheel_ = last_wheel;
   last_standstill_.reset();
-  first_reject_t_ = -1.0;
-  rejects_since_accept_ = 0;
   last_sigma_p_ = 0.0;
   reset_reason_.clear();
-  if (resets_.size() < kMaxListed) resets_.push_back({m.t, reason});
+  watchdog_.Reset(m.t, reason);
   LOG(WARNING) << "smoother watchdog: window rebuilt from GNSS at t=" << std::fixed << m.t << " (" << reason
                << (have_velocity ? "; velocity from the last two fixes" : "; velocity kept") << ")";
 }
@@ -575,9 +564,24 @@ bool Smoother::Solve() {
   ceres::Solver::Options so;
   so.linear_solver_type = options_.smoother.linear_solver == "sparse_normal_cholesky" ? ceres::SPARSE_NORMAL_CHOLESKY
                                                                                       : ceres::DENSE_SCHUR;
-  // SuiteSparse when Ceres has it (Debian's does), Eigen's sparse Cholesky otherwise.
-  if (!ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)) {
-    so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
+  if (so.linear_solver_type == ceres::SPARSE_NORMAL_CHOLESKY) {
+    // SuiteSparse when Ceres has it (Debian's does), Eigen's sparse Cholesky otherwise.
+    if (!ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)) {
+      so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
+    }
+    // Eliminate in time order, one block after the other: no fill-in along the chain, and the same order
+    // every run. Ceres's default ordering is a set of block addresses, so the last bits of the solution
+    // would follow the heap's layout.
+    auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+    int group = 0;
+    for (const auto& kf : window_) {
+      for (double* b : {kf->pose, kf->vel, kf->bias, kf->scale}) {
+        if (problem_->HasParameterBlock(b) && !problem_->IsParameterBlockConstant(b)) {
+          ordering->AddElementToGroup(b, group++);
+        }
+      }
+    }
+    so.linear_solver_ordering = ordering;
   }
   so.max_num_iterations = options_.smoother.max_iterations;
   so.function_tolerance = options_.smoother.function_tolerance;
@@ -696,13 +700,18 @@ void Smoother::MarginalizeOldest() {
   // Schur complement of every factor touching the oldest keyframe.
   MarginalizationInfo info;
   std::vector<double*> marg_blocks = {kf0.pose, kf0.vel, kf0.bias, kf0.scale};
-  std::vector<ceres::ResidualBlockId> ids;
-  for (double* b : marg_blocks) {
-    std::vector<ceres::ResidualBlockId> bi;
-    problem_->GetResidualBlocksForParameterBlock(b, &bi);
-    for (auto id : bi) {
-      if (std::find(ids.begin(), ids.end(), id) == ids.end()) ids.push_back(id);
-    }
+  // In the problem's own (insertion) order, not GetResidualBlocksForParameterBlock's, which follows a hash
+  // of addresses: the sums of the Schur complement, and so the last bits of every later estimate, would
+  // then change from run to run with the heap's layout.
+  std::vector<ceres::ResidualBlockId> all_ids, ids;
+  problem_->GetResidualBlocks(&all_ids);
+  for (auto id : all_ids) {
+    std::vector<double*> params;
+    problem_->GetParameterBlocksForResidualBlock(id, &params);
+    const bool touches = std::any_of(params.begin(), params.end(), [&](double* b) {
+      return std::find(marg_blocks.begin(), marg_blocks.end(), b) != marg_blocks.end();
+    });
+    if (touches) ids.push_back(id);
   }
   std::vector<double*> declared;
   auto declare = [&](double* b) {
@@ -729,7 +738,11 @@ void Smoother::MarginalizeOldest() {
 
   if (have_cov) last_sigma_p_ = std::sqrt(cov.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
   EmitFinal(kf0, kf1, have_cov ? &cov : nullptr);
-  for (double* b : marg_blocks) problem_->RemoveParameterBlock(b);  // and every residual on them
+  // Residuals first, in program order: RemoveParameterBlock would remove them in the order of a hash set of
+  // addresses, and each removal moves the problem's last residual into the hole, so the residual order (and
+  // the last bits of every later solve) would follow the heap's layout.
+  for (auto id : ids) problem_->RemoveResidualBlock(id);
+  for (double* b : marg_blocks) problem_->RemoveParameterBlock(b);
   prior_id_ = nullptr;
   if (prior) prior_id_ = problem_->AddResidualBlock(prior.release(), nullptr, kept);
   window_.pop_front();
@@ -811,9 +824,7 @@ nlohmann::json Smoother::Stats() const {
   j["imu_gaps"] = imu_gaps_;
   j["imu_gap_times"] = nlohmann::json::array();
   for (const auto& [a, b] : gap_times_) j["imu_gap_times"].push_back({a, b});
-  nlohmann::json resets = nlohmann::json::array();
-  for (const Reset& r : resets_) resets.push_back({{"time", r.t}, {"reason", r.reason}});
-  j["watchdog"] = {{"resets", resets}, {"count", resets_.size()}};
+  j["watchdog"] = watchdog_.ToJson();
   return j;
 }
 

@@ -107,14 +107,7 @@ class Smoother : public Estimator {
   double gnss_gate_ = 0.0, zupt_gate_ = 0.0;
   double initial_scale_ = 1.0;  // odometer scale of the first keyframe (kept across a watchdog reset)
 
-  // Watchdog.
-  struct Reset {
-    double t;
-    std::string reason;
-  };
-  std::vector<Reset> resets_;
-  double first_reject_t_ = -1.0;  // first rejected fix since the last accepted one (< 0: none)
-  int rejects_since_accept_ = 0;
+  GnssWatchdog watchdog_;
   std::string reset_reason_;      // set by the checks, acted on at the end of AddGnss
   std::optional<GnssMeasurement> prev_fix_;
   double last_sigma_p_ = 0.0;     // largest position 1-σ of the last keyframe marginalised

@@ -77,7 +77,7 @@ done
 rm -f "$out/time.txt" "$out/stderr.txt"
 {
   echo
-  echo "Machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), $(free -g | awk '/Mem:/ {print $2}') GB;" \
+  echo "Machine: $(nproc) cores, $(sed -n 's/^model name\t*: *//p' /proc/cpuinfo | head -1), $(awk '/MemTotal/ {printf "%.0f", $2 / 1048576}' /proc/meminfo) GB;" \
     "gins $(git rev-parse --short HEAD 2>/dev/null || echo '?'); $(date -u +%Y-%m-%d)."
 } >>"$out/results.md"
 cat "$out/results.md"

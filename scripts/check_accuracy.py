@@ -14,7 +14,6 @@ usage: check_accuracy.py --truth truth.csv[.gz] --log log.txt[.gz] TRAJ.tum [TRA
        check_accuracy.py --truth truth.csv[.gz] --summary RUN/summary.json --compare EVAL.json TRAJ...
 """
 import argparse
-import gzip
 import json
 import math
 import os
@@ -22,31 +21,7 @@ import sys
 
 import numpy as np
 
-A = 6378137.0
-F = 1.0 / 298.257223563
-E2 = F * (2 - F)
-
-
-def open_text(path):
-    with open(path, "rb") as f:
-        magic = f.read(2)
-    return gzip.open(path, "rt") if magic == b"\x1f\x8b" else open(path, "rt")
-
-
-def lla_to_ecef(lat, lon, alt):
-    lat, lon = np.radians(lat), np.radians(lon)
-    n = A / np.sqrt(1 - E2 * np.sin(lat) ** 2)
-    return np.stack([(n + alt) * np.cos(lat) * np.cos(lon), (n + alt) * np.cos(lat) * np.sin(lon),
-                     (n * (1 - E2) + alt) * np.sin(lat)], axis=-1)
-
-
-def lla_to_enu(lat, lon, alt, origin):
-    lat0, lon0 = math.radians(origin[0]), math.radians(origin[1])
-    d = lla_to_ecef(lat, lon, alt) - lla_to_ecef(np.array(origin[0]), np.array(origin[1]), np.array(origin[2]))
-    r = np.array([[-math.sin(lon0), math.cos(lon0), 0],
-                  [-math.sin(lat0) * math.cos(lon0), -math.sin(lat0) * math.sin(lon0), math.cos(lat0)],
-                  [math.cos(lat0) * math.cos(lon0), math.cos(lat0) * math.sin(lon0), math.sin(lat0)]])
-    return d @ r.T
+from gins_geo import lla_to_enu, open_text, rot_enu_from_ecef  # noqa: E402
 
 
 def yaw_of(qw, qx, qy, qz):
@@ -79,16 +54,6 @@ def gnss_gaps(log_path, min_gap):
 
 
 # ---- The metrics of `gins eval`, recomputed (--compare) --------------------------------------------------
-
-def rot_enu_from_ecef(lat_deg, lon_deg):
-    """Rows: the E, N, U unit vectors in ECEF (vectorised over points)."""
-    lat, lon = np.radians(lat_deg), np.radians(lon_deg)
-    sl, cl, so, co = np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon)
-    z = np.zeros_like(lat)
-    return np.stack([np.stack([-so, co, z], -1),
-                     np.stack([-sl * co, -sl * so, cl], -1),
-                     np.stack([cl * co, cl * so, sl], -1)], -2)
-
 
 def quat_to_rot(q):  # q: (..., 4) as w, x, y, z
     w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]

@@ -15,7 +15,6 @@ The truth and log default to those recorded in RUN_DIR/summary.json (when the fi
 matplotlib only (Debian: python3-numpy, python3-matplotlib).
 """
 import argparse
-import gzip
 import json
 import math
 import os
@@ -28,9 +27,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
-A = 6378137.0
-F = 1.0 / 298.257223563
-E2 = F * (2 - F)
+from gins_geo import lla_to_enu as to_enu, open_text, rot_enu_from_ecef as r_enu_ecef  # noqa: E402
 
 STYLE = {  # name: (label, colour)
     "eskf": ("ESKF", "tab:blue"),
@@ -39,32 +36,6 @@ STYLE = {  # name: (label, colour)
 TRUTH_COLOUR = "black"
 OUTAGE_COLOUR = "tab:red"
 GAP_COLOUR = "0.55"
-
-
-def open_text(path):
-    with open(path, "rb") as f:
-        magic = f.read(2)
-    return gzip.open(path, "rt") if magic == b"\x1f\x8b" else open(path, "rt")
-
-
-def ecef(lat, lon, alt):
-    lat, lon = np.radians(lat), np.radians(lon)
-    n = A / np.sqrt(1 - E2 * np.sin(lat) ** 2)
-    return np.stack([(n + alt) * np.cos(lat) * np.cos(lon), (n + alt) * np.cos(lat) * np.sin(lon),
-                     (n * (1 - E2) + alt) * np.sin(lat)], axis=-1)
-
-
-def r_enu_ecef(lat, lon):
-    lat, lon = np.radians(lat), np.radians(lon)
-    sl, cl, so, co = np.sin(lat), np.cos(lat), np.sin(lon), np.cos(lon)
-    z = np.zeros_like(lat)
-    return np.stack([np.stack([-so, co, z], -1), np.stack([-sl * co, -sl * so, cl], -1),
-                     np.stack([cl * co, cl * so, sl], -1)], -2)
-
-
-def to_enu(lat, lon, alt, origin):
-    d = ecef(lat, lon, alt) - ecef(np.array(origin[0]), np.array(origin[1]), np.array(origin[2]))
-    return d @ r_enu_ecef(np.array(origin[0]), np.array(origin[1])).T
 
 
 def quat_rot(q):  # w, x, y, z -> R

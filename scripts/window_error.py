@@ -6,37 +6,12 @@ Positions are compared at the truth's sample times (trajectory interpolated line
 of the trajectory's origin_lla header (DESIGN §4, §5). numpy only.
 """
 import argparse
-import gzip
 import math
 import sys
 
 import numpy as np
 
-A = 6378137.0
-F = 1.0 / 298.257223563
-E2 = F * (2 - F)
-
-
-def open_text(path):
-    with open(path, "rb") as f:
-        magic = f.read(2)
-    return gzip.open(path, "rt") if magic == b"\x1f\x8b" else open(path, "rt")
-
-
-def ecef(lat, lon, alt):
-    lat, lon = np.radians(lat), np.radians(lon)
-    n = A / np.sqrt(1 - E2 * np.sin(lat) ** 2)
-    return np.stack([(n + alt) * np.cos(lat) * np.cos(lon), (n + alt) * np.cos(lat) * np.sin(lon),
-                     (n * (1 - E2) + alt) * np.sin(lat)], axis=-1)
-
-
-def enu(lat, lon, alt, origin):
-    la, lo = math.radians(origin[0]), math.radians(origin[1])
-    d = ecef(lat, lon, alt) - ecef(np.array(origin[0]), np.array(origin[1]), np.array(origin[2]))
-    r = np.array([[-math.sin(lo), math.cos(lo), 0],
-                  [-math.sin(la) * math.cos(lo), -math.sin(la) * math.sin(lo), math.cos(la)],
-                  [math.cos(la) * math.cos(lo), math.cos(la) * math.sin(lo), math.sin(la)]])
-    return d @ r.T
+from gins_geo import lla_to_enu as enu, open_text  # noqa: E402
 
 
 def main():

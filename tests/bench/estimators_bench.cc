@@ -11,6 +11,7 @@
 #include "solver/eskf.h"
 #include "solver/session.h"
 #include "solver/smoother.h"
+#include "sim_feed.h"
 #include "test_scenarios.h"
 
 namespace gins {
@@ -28,20 +29,6 @@ const std::vector<SimRecord>& DriveRecords() {
   return records;
 }
 
-void Feed(Session* s, const SimRecord& r) {
-  switch (r.type) {
-    case SimRecord::Type::kImu:
-      s->AddImu(r.imu);
-      break;
-    case SimRecord::Type::kOdom:
-      s->AddOdom(r.odom);
-      break;
-    case SimRecord::Type::kGnss:
-      s->AddGnss(r.gnss);
-      break;
-  }
-}
-
 // Runs the whole drive through one estimator per iteration; reports the cost per IMU sample and per
 // GNSS epoch (the smoother solves once per epoch).
 template <typename MakeEstimator>
@@ -53,7 +40,7 @@ void RunDrive(benchmark::State& state, MakeEstimator make) {
     Session session(options);
     session.AddEstimator(make(options));
     for (const auto& r : records) {
-      Feed(&session, r);
+      test::FeedSession(&session, r);
       imu += r.type == SimRecord::Type::kImu;
       gnss += r.type == SimRecord::Type::kGnss;
     }
@@ -84,7 +71,7 @@ class EskfFixture {
     session_ = std::make_unique<Session>(options_);
     session_->AddEstimator(std::move(eskf));
     for (const auto& r : DriveRecords()) {
-      Feed(session_.get(), r);
+      test::FeedSession(session_.get(), r);
       if (session_->initialized() && r.type == SimRecord::Type::kGnss) break;
     }
   }
@@ -253,7 +240,7 @@ const StepDriveInputs& StepInputs() {
     session.AddEstimator(std::make_unique<Recorder>(&out.init, &out.inputs));
     Simulator simulator(sim);
     SimRecord r;
-    while (simulator.Next(&r)) Feed(&session, r);
+    while (simulator.Next(&r)) test::FeedSession(&session, r);
     return out;
   }();
   return in;

@@ -9,6 +9,7 @@
 #include "core/simulator.h"
 #include "core/so3.h"
 #include "solver/session.h"
+#include "sim_feed.h"
 #include "test_scenarios.h"
 
 namespace gins {
@@ -44,17 +45,7 @@ DriveResult RunDrive(const SimOptions& sim, const Options& options) {
   double last_nees_t = -1e9;
   SimRecord rec;
   while (simulator.Next(&rec)) {
-    switch (rec.type) {
-      case SimRecord::Type::kImu:
-        session.AddImu(rec.imu);
-        break;
-      case SimRecord::Type::kOdom:
-        session.AddOdom(rec.odom);
-        break;
-      case SimRecord::Type::kGnss:
-        session.AddGnss(rec.gnss);
-        break;
-    }
+    test::FeedSession(&session, rec);
     if (rec.type != SimRecord::Type::kImu || !session.initialized()) continue;
     const NavState& x = eskf->state();
     const NavState& truth = rec.truth;

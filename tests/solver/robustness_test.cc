@@ -15,6 +15,7 @@
 #include "solver/eskf.h"
 #include "solver/session.h"
 #include "solver/smoother.h"
+#include "sim_feed.h"
 #include "test_scenarios.h"
 
 namespace gins {
@@ -61,17 +62,7 @@ Output RunDrive(const SimOptions& sim, const Options& options, const Edit& edit)
       out.truth_p.push_back(rec.truth.p_wb);
     }
     if (edit && !edit(&rec)) continue;
-    switch (rec.type) {
-      case SimRecord::Type::kImu:
-        session.AddImu(rec.imu);
-        break;
-      case SimRecord::Type::kOdom:
-        session.AddOdom(rec.odom);
-        break;
-      case SimRecord::Type::kGnss:
-        session.AddGnss(rec.gnss);
-        break;
-    }
+    test::FeedSession(&session, rec);
   }
   session.Finish();
   out.eskf_stats = eskf_ptr->Stats();

@@ -15,6 +15,7 @@
 #include "core/so3.h"
 #include "solver/eskf.h"
 #include "solver/session.h"
+#include "sim_feed.h"
 #include "test_scenarios.h"
 
 namespace gins {
@@ -123,20 +124,13 @@ DriveOutput RunDrive(const SimOptions& sim, const Options& options, bool with_es
 
   SimRecord rec;
   while (simulator.Next(&rec)) {
-    switch (rec.type) {
-      case SimRecord::Type::kImu:
-        session.AddImu(rec.imu);
-        out.truth.t.push_back(rec.imu.t);
-        out.truth.x.push_back(rec.truth);
-        if (session.initialized()) ++out.imu_after_init;
-        break;
-      case SimRecord::Type::kOdom:
-        session.AddOdom(rec.odom);
-        break;
-      case SimRecord::Type::kGnss:
-        session.AddGnss(rec.gnss);
-        if (rec.gnss_outlier) out.outlier_times.push_back(rec.gnss.t);
-        break;
+    test::FeedSession(&session, rec);
+    if (rec.type == SimRecord::Type::kImu) {
+      out.truth.t.push_back(rec.imu.t);
+      out.truth.x.push_back(rec.truth);
+      if (session.initialized()) ++out.imu_after_init;
+    } else if (rec.type == SimRecord::Type::kGnss && rec.gnss_outlier) {
+      out.outlier_times.push_back(rec.gnss.t);
     }
   }
   session.Finish();

@@ -26,9 +26,6 @@ constexpr size_t kMaxListed = 100;                  // gaps and resets listed in
 constexpr double kZeroRateGateProbability = 0.9999;  // the gyro-reads-its-bias update at standstills
 // Watchdog re-initialisation: position 1-σ added to the fix's, velocity 1-σ, and the longest fix interval
 // a velocity is differenced over.
-constexpr double kResetPosSigma = 1.0;  // m
-constexpr double kResetVelSigma = 1.0;  // m/s
-constexpr double kResetMaxFixInterval = 2.0;  // s
 
 }  // namespace
 
@@ -333,28 +330,7 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
     }
     if (options_.wheel.enabled && options_.wheel.estimate_scale) P_(eskf::kS, eskf::kS) = std::pow(options_.wheel.scale_sigma, 2);
   }
-  x_.t = m.t;
-  x_.p_wb = m.p_w - x_.q_wb * options_.gnss.lever_b;
-  bool have_velocity = false;
-  if (prev_fix_ && m.t - prev_fix_->t > 0.0 && m.t - prev_fix_->t <= kResetMaxFixInterval) {
-    x_.v_w = (m.p_w - prev_fix_->p_w) / (m.t - prev_fix_->t);
-    have_velocity = true;
-  }
-  // Position and velocity start afresh: no correlation with what they were.
-  for (int k : {nav::kP, nav::kV}) {
-    P_.block<3, eskf::kDim>(k, 0).setZero();
-    P_.block<eskf::kDim, 3>(0, k).setZero();
-  }
-  // Well inside watchdog.max_position_sigma_m, or the next check would reset again.
-  const double sigma_p = std::min(kResetPosSigma, 0.25 * options_.watchdog.max_position_sigma);
-  P_.block<3, 3>(nav::kP, nav::kP).diagonal() = m.sigma_w.cwiseAbs2() + Vec3::Constant(sigma_p * sigma_p);
-  const double sigma_v = std::min(have_velocity ? kResetVelSigma : 2.0, 0.25 * options_.watchdog.max_position_sigma);
-  P_.block<3, 3>(nav::kV, nav::kV).diagonal().setConstant(sigma_v * sigma_v);
-  // A diverged filter may have a wrong yaw: let the next measurements correct it.
-  const Vec3 z_b = x_.q_wb.conjugate() * Vec3::UnitZ();
-  const double yaw_var = z_b.dot(P_.block<3, 3>(nav::kTheta, nav::kTheta) * z_b);
-  const double min_yaw_var = options_.init.sigma_yaw * options_.init.sigma_yaw;
-  if (yaw_var < min_yaw_var) P_.block<3, 3>(nav::kTheta, nav::kTheta) += (min_yaw_var - yaw_var) * z_b * z_b.transpose();
+  const bool have_velocity = ResetPositionFromFix(m, prev_fix_, options_, &x_, P_);
   P_ = 0.5 * (P_ + P_.transpose());
   gyro_sum_.setZero();
   gyro_count_ = 0;

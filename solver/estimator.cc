@@ -1,9 +1,42 @@
 #include "solver/estimator.h"
 
+#include <algorithm>
+
 namespace gins {
 
 namespace {
 constexpr size_t kMaxListedTimes = 100;
+// Re-initialisation from GNSS.
+constexpr double kResetPosSigma = 1.0;        // m, added to the fix's σ
+constexpr double kResetVelSigma = 1.0;        // m/s, velocity from two fixes
+constexpr double kResetKeptVelSigma = 2.0;    // m/s, velocity kept from the diverged estimate
+constexpr double kResetMaxFixInterval = 2.0;  // s, longest interval of two fixes giving the velocity
+}  // namespace
+
+bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
+                          const Options& options, NavState* x, Eigen::Ref<MatX> P) {
+  x->t = m.t;
+  x->p_wb = m.p_w - x->q_wb * options.gnss.lever_b;
+  bool have_velocity = false;
+  if (prev_fix && m.t - prev_fix->t > 0.0 && m.t - prev_fix->t <= kResetMaxFixInterval) {
+    x->v_w = (m.p_w - prev_fix->p_w) / (m.t - prev_fix->t);
+    have_velocity = true;
+  }
+  for (int k : {nav::kP, nav::kV}) {
+    P.middleRows(k, 3).setZero();
+    P.middleCols(k, 3).setZero();
+  }
+  // Well inside watchdog.max_position_sigma_m, or the next check would reset again.
+  const double cap = 0.25 * options.watchdog.max_position_sigma;
+  const double sigma_p = std::min(kResetPosSigma, cap);
+  P.block<3, 3>(nav::kP, nav::kP).diagonal() = m.sigma_w.cwiseAbs2() + Vec3::Constant(sigma_p * sigma_p);
+  const double sigma_v = std::min(have_velocity ? kResetVelSigma : kResetKeptVelSigma, cap);
+  P.block<3, 3>(nav::kV, nav::kV).diagonal().setConstant(sigma_v * sigma_v);
+  const Vec3 z_b = x->q_wb.conjugate() * Vec3::UnitZ();
+  const double yaw_var = z_b.dot(P.block<3, 3>(nav::kTheta, nav::kTheta) * z_b);
+  const double min_yaw_var = options.init.sigma_yaw * options.init.sigma_yaw;
+  if (yaw_var < min_yaw_var) P.block<3, 3>(nav::kTheta, nav::kTheta) += (min_yaw_var - yaw_var) * z_b * z_b.transpose();
+  return have_velocity;
 }
 
 void MeasurementCounts::Reject(const std::string& reason, double t) {

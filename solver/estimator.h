@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -60,6 +61,15 @@ class GnssWatchdog {
   std::vector<Event> resets_;     // the first few
   uint64_t count_ = 0;
 };
+
+// The watchdog's re-initialisation from a GNSS fix m, alike in both estimators: position from the fix
+// through the lever arm, velocity from the previous fix when it is recent (else kept), and both with a fresh
+// covariance, uncorrelated with the rest; the yaw variance is raised to at least init.sigma_yaw, since a
+// diverged estimate may have a wrong yaw. P is the covariance in NavState tangent order (its first 15 rows
+// and columns; more, e.g. the ESKF's gravity and scale, are left but decorrelated from δp and δv).
+// Returns whether the velocity came from the fixes.
+bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
+                          const Options& options, NavState* x, Eigen::Ref<MatX> P);
 
 class Estimator {
  public:

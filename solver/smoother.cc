@@ -38,9 +38,6 @@ constexpr double kGapAccSigma = 2.0;                // m/s²
 constexpr double kGapRateSigma = 10.0 * kDegToRad;  // rad/s
 constexpr size_t kMaxListed = 100;
 // Watchdog re-initialisation, as in the ESKF.
-constexpr double kResetPosSigma = 1.0;        // m, added to the fix's σ
-constexpr double kResetVelSigma = 1.0;        // m/s
-constexpr double kResetMaxFixInterval = 2.0;  // s
 
 // Tangent layout of one keyframe in covariance blocks: pose (δp, δθ), vel (δv), bias (δbg, δba).
 // NavState tangent order is δp, δv, δθ, δbg, δba; this maps keyframe-tangent index -> NavState index.
@@ -522,26 +519,7 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
     cov.block<3, 3>(nav::kBa, nav::kBa).diagonal().setConstant(std::pow(options_.imu.init_acc_bias_sigma, 2));
   }
   init.g_norm = g_w_.norm();
-  init.x0.t = m.t;
-  init.x0.p_wb = m.p_w - init.x0.q_wb * options_.gnss.lever_b;
-  bool have_velocity = false;
-  if (prev_fix_ && m.t - prev_fix_->t > 0.0 && m.t - prev_fix_->t <= kResetMaxFixInterval) {
-    init.x0.v_w = (m.p_w - prev_fix_->p_w) / (m.t - prev_fix_->t);
-    have_velocity = true;
-  }
-  for (int k : {nav::kP, nav::kV}) {
-    cov.block<3, nav::kDim>(k, 0).setZero();
-    cov.block<nav::kDim, 3>(0, k).setZero();
-  }
-  // Well inside watchdog.max_position_sigma_m, or the next check would reset again.
-  const double sigma_p = std::min(kResetPosSigma, 0.25 * options_.watchdog.max_position_sigma);
-  cov.block<3, 3>(nav::kP, nav::kP).diagonal() = m.sigma_w.cwiseAbs2() + Vec3::Constant(sigma_p * sigma_p);
-  const double sigma_v = std::min(have_velocity ? kResetVelSigma : 2.0, 0.25 * options_.watchdog.max_position_sigma);
-  cov.block<3, 3>(nav::kV, nav::kV).diagonal().setConstant(sigma_v * sigma_v);
-  const Vec3 z_b = init.x0.q_wb.conjugate() * Vec3::UnitZ();
-  const double yaw_var = z_b.dot(cov.block<3, 3>(nav::kTheta, nav::kTheta) * z_b);
-  const double min_yaw_var = options_.init.sigma_yaw * options_.init.sigma_yaw;
-  if (yaw_var < min_yaw_var) cov.block<3, 3>(nav::kTheta, nav::kTheta) += (min_yaw_var - yaw_var) * z_b * z_b.transpose();
+  const bool have_velocity = ResetPositionFromFix(m, prev_fix_, options_, &init.x0, cov);
   // Tiny floors keep the prior invertible whatever the window's covariance was.
   cov = 0.5 * (cov + cov.transpose());
   cov.diagonal() = cov.diagonal().cwiseMax(1e-12);

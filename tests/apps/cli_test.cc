@@ -25,8 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// RunCli(args) in a child process; returns its exit code (-1 if it did not exit normally).
-int RunCliInChild(const std::vector<std::string>& args) {
+// RunCli(args) in a child process; returns its exit code (-1 if it did not exit normally). With an
+// err_path, the child's stderr goes to that file and is read into *err.
+int RunCliCapturingStderr(const std::vector<std::string>& args, const std::string& err_path, std::string* err) {
   std::vector<const char*> argv = {"gins"};
   for (const auto& a : args) argv.push_back(a.c_str());
   std::fflush(stdout);
@@ -34,6 +35,10 @@ int RunCliInChild(const std::vector<std::string>& args) {
   const pid_t pid = fork();
   if (pid < 0) return -1;
   if (pid == 0) {
+    if (!err_path.empty()) {
+      std::FILE* f = std::fopen(err_path.c_str(), "w");
+      if (f == nullptr || dup2(fileno(f), 2) < 0) _exit(97);
+    }
     int code = 99;
     try {
       code = RunCli(static_cast<int>(argv.size()), argv.data());
@@ -46,35 +51,11 @@ int RunCliInChild(const std::vector<std::string>& args) {
   }
   int status = 0;
   if (waitpid(pid, &status, 0) != pid) return -1;
+  if (!err_path.empty()) *err = test::ReadFile(err_path);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-// As RunCliInChild, with the child's stderr captured into *err.
-int RunCliCapturingStderr(const std::vector<std::string>& args, const std::string& err_path, std::string* err) {
-  std::vector<const char*> argv = {"gins"};
-  for (const auto& a : args) argv.push_back(a.c_str());
-  std::fflush(stdout);
-  std::fflush(stderr);
-  const pid_t pid = fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    std::FILE* f = std::fopen(err_path.c_str(), "w");
-    if (f == nullptr || dup2(fileno(f), 2) < 0) _exit(97);
-    int code = 99;
-    try {
-      code = RunCli(static_cast<int>(argv.size()), argv.data());
-    } catch (...) {
-      code = 98;
-    }
-    std::fflush(stdout);
-    std::fflush(stderr);
-    _exit(code);
-  }
-  int status = 0;
-  if (waitpid(pid, &status, 0) != pid) return -1;
-  *err = test::ReadFile(err_path);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+int RunCliInChild(const std::vector<std::string>& args) { return RunCliCapturingStderr(args, "", nullptr); }
 
 std::vector<std::string> Lines(const std::string& text) {
   std::vector<std::string> lines;

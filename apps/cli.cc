@@ -9,8 +9,8 @@
 
 #include "apps/eval_command.h"
 #include "config/config_loader.h"
-#include "core/log_reader.h"
-#include "core/simulator.h"
+#include "core/io/log_reader.h"
+#include "core/sim/simulator.h"
 #include "solver/runner.h"
 
 namespace gins {

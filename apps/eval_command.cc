@@ -9,12 +9,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/evaluation.h"
-#include "core/log_reader.h"
-#include "core/trajectory_metrics.h"
-#include "core/trajectory_reader.h"
-#include "core/trajectory_writer.h"
-#include "solver/run_comparison.h"
+#include "core/eval/evaluation.h"
+#include "core/io/log_reader.h"
+#include "core/eval/trajectory_metrics.h"
+#include "core/io/trajectory_reader.h"
+#include "core/io/trajectory_writer.h"
+#include "core/eval/run_comparison.h"
 
 namespace gins {
 namespace {

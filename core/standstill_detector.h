@@ -12,10 +12,20 @@
 
 #include <deque>
 
-#include "config/options.h"
+#include "core/conventions.h"
 #include "core/measurements.h"
 
 namespace gins {
+
+// standstill.*: zero-velocity and zero-rotation updates while the vehicle stands (core/standstill_detector.h).
+struct StandstillOptions {
+  bool enabled = true;                    // standstill.enabled
+  double window = 1.0;                    // standstill.window_s: IMU samples judged together
+  double max_gyro_std = 0.5 * kDegToRad;  // standstill.max_gyro_std_deg_s: "IMU quiet" thresholds
+  double max_acc_std = 0.1;               // standstill.max_acc_std_m_s2
+  double velocity_sigma = 0.01;           // standstill.velocity_sigma_m_s: 1-σ of the zero velocity
+  double max_speed = 0.5;                 // standstill.max_speed_m_s: ignore a detection above this speed
+};
 
 class StandstillDetector {
  public:

@@ -45,7 +45,7 @@ WindowStats ComputeStats(const std::deque<ImuSample>& w) {
 
 }  // namespace
 
-StaticInitializer::StaticInitializer(const Options& options, double g_norm) : options_(options), g_norm_(g_norm) {}
+StaticInitializer::StaticInitializer(const InitializerOptions& options, double g_norm) : options_(options), g_norm_(g_norm) {}
 
 bool StaticInitializer::WindowIsStatic() const {
   if (window_.size() < 10) return false;

@@ -12,12 +12,30 @@
 #include <string>
 #include <vector>
 
-#include "config/options.h"
+#include "core/sensors.h"
 #include "core/imu_kernel.h"
 #include "core/measurements.h"
 #include "core/nav_state.h"
 
 namespace gins {
+
+// init.*
+struct InitOptions {
+  double static_duration = 2.0;     // init.static_duration_s: standstill needed before starting
+  double max_gyro_std = 0.5 * kDegToRad;  // init.max_gyro_std_deg_s: "IMU quiet" thresholds
+  double max_acc_std = 0.1;         // init.max_acc_std_m_s2
+  double max_wait = 300.0;          // init.max_wait_s: give up if no standstill was found by then
+  bool wait_for_heading = true;     // init.wait_for_heading: take yaw from the first valid heading
+  double sigma_pos = 0.1;           // init.sigma_pos_m   (added to the first fix's σ)
+  double sigma_vel = 0.05;          // init.sigma_vel_m_s
+  double sigma_roll_pitch = 0.5 * kDegToRad;  // init.sigma_roll_pitch_deg
+  double sigma_yaw = 2.0 * kDegToRad;         // init.sigma_yaw_deg (no heading: 180)
+};
+
+// What the initialisation needs: the sensors and its own settings.
+struct InitializerOptions : SensorOptions {
+  InitOptions init;
+};
 
 struct InitResult {
   NavState x0;                    // at x0.t, the GNSS epoch that completed the initialisation
@@ -33,7 +51,7 @@ struct InitResult {
 
 class StaticInitializer {
  public:
-  StaticInitializer(const Options& options, double g_norm);
+  StaticInitializer(const InitializerOptions& options, double g_norm);
 
   void AddImu(const ImuSample& imu);
   void AddWheel(const WheelMeasurement& wheel);
@@ -49,7 +67,7 @@ class StaticInitializer {
   void StartFromStandstill();
   void Finish(const GnssMeasurement& gnss, double yaw_offset, const std::string& source);
 
-  Options options_;
+  InitializerOptions options_;
   double g_norm_;
   std::deque<ImuSample> window_;   // IMU samples of the current candidate standstill
   std::deque<WheelMeasurement> wheel_window_;

@@ -29,7 +29,7 @@ constexpr double kZeroRateGateProbability = 0.9999;  // the gyro-reads-its-bias 
 
 }  // namespace
 
-Eskf::Eskf(const Options& options, StateCallback on_state)
+Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state)
     : options_(options), on_state_(std::move(on_state)), watchdog_(options.watchdog) {
   gate_gnss_ = GateFor(options_.gnss.gate_probability, 3);
   gate_heading_ = GateFor(options_.gnss.gate_probability, 1);

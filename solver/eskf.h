@@ -24,7 +24,7 @@
 #include <utility>
 #include <vector>
 
-#include "config/options.h"
+#include "solver/estimator_options.h"
 #include "solver/estimator.h"
 
 namespace gins {
@@ -40,7 +40,7 @@ class Eskf : public Estimator {
   using MatP = Eigen::Matrix<double, eskf::kDim, eskf::kDim>;
   using VecP = Eigen::Matrix<double, eskf::kDim, 1>;
 
-  Eskf(const Options& options, StateCallback on_state);
+  Eskf(const EstimatorOptions& options, StateCallback on_state);
 
   std::string name() const override { return "eskf"; }
   void Initialize(const InitResult& init) override;
@@ -70,7 +70,7 @@ class Eskf : public Estimator {
   bool WatchGnss(const GnssMeasurement& m, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
 
-  Options options_;
+  EstimatorOptions options_;
   StateCallback on_state_;
   bool initialized_ = false;
   NavState x_;

@@ -14,7 +14,7 @@ constexpr double kResetMaxFixInterval = 2.0;  // s, longest interval of two fixe
 }  // namespace
 
 bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                          const Options& options, NavState* x, Eigen::Ref<MatX> P) {
+                          const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P) {
   x->t = m.t;
   x->p_wb = m.p_w - x->q_wb * options.gnss.lever_b;
   bool have_velocity = false;

@@ -9,10 +9,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "config/options.h"
 #include "core/measurements.h"
 #include "core/nav_state.h"
 #include "core/static_init.h"
+#include "solver/estimator_options.h"
 
 namespace gins {
 
@@ -69,7 +69,7 @@ class GnssWatchdog {
 // and columns; more, e.g. the ESKF's gravity and scale, are left but decorrelated from δp and δv).
 // Returns whether the velocity came from the fixes.
 bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                          const Options& options, NavState* x, Eigen::Ref<MatX> P);
+                          const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P);
 
 class Estimator {
  public:

@@ -6,12 +6,12 @@
 #include <memory>
 #include <optional>
 
-#include "core/batch_pipe.h"
+#include "core/io/batch_pipe.h"
 #include "core/geodesy.h"
-#include "core/log_reader.h"
-#include "core/trajectory_writer.h"
+#include "core/io/log_reader.h"
+#include "core/io/trajectory_writer.h"
 #include "solver/eskf.h"
-#include "solver/run_comparison.h"
+#include "core/eval/run_comparison.h"
 #include "solver/session.h"
 #include "solver/smoother.h"
 
@@ -86,7 +86,7 @@ nlohmann::json MetricsJson(const AccuracyMetrics& m) {
 
 std::vector<std::string> SupportedModes() { return {"eskf", "smoother", "both"}; }
 
-RunResult Run(const Options& options, const RunRequest& request) {
+RunResult Run(const RunOptions& options, const RunRequest& request) {
   const auto wall_start = Clock::now();
   const auto modes = SupportedModes();
   if (std::find(modes.begin(), modes.end(), request.mode) == modes.end()) {

@@ -10,15 +10,16 @@
 
 #include <nlohmann/json.hpp>
 
-#include "config/options.h"
-#include "core/evaluation.h"
+#include "core/eval/evaluation.h"
+#include "core/io/log_reader.h"
+#include "solver/estimator_options.h"
+#include "solver/session.h"
 
 namespace gins {
 
-// A run that cannot produce a trajectory (no standstill, no GNSS, ...). what() is one line.
-class RunError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
+// What one run reads: the estimators' options and how to read the log.
+struct RunOptions : EstimatorOptions {
+  InputOptions input;
 };
 
 struct RunRequest {
@@ -37,7 +38,7 @@ struct RunResult {
 
 // Throws InputError (bad log), RunError (no solution possible) or std::runtime_error (I/O). Nothing is
 // left in out_dir when it throws.
-RunResult Run(const Options& options, const RunRequest& request);
+RunResult Run(const RunOptions& options, const RunRequest& request);
 
 // The estimator modes Run() accepts.
 std::vector<std::string> SupportedModes();

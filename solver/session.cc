@@ -1,7 +1,6 @@
 #include "solver/session.h"
 
 #include "core/wheel_model.h"
-#include "solver/runner.h"
 
 namespace gins {
 namespace {
@@ -9,7 +8,7 @@ namespace {
 constexpr size_t kMaxPending = 100000;
 }  // namespace
 
-Session::Session(const Options& options) : options_(options) {
+Session::Session(const EstimatorOptions& options) : options_(options) {
   if (options_.gnss.origin) frame_.emplace(*options_.gnss.origin);
   if (!options_.gravity.use_normal_gravity) g_norm_ = options_.gravity.magnitude;
 }

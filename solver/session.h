@@ -7,23 +7,31 @@
 #include <chrono>
 #include <memory>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "config/options.h"
 #include "core/geodesy.h"
-#include "core/gnss_outages.h"
+#include "core/eval/gnss_outages.h"
 #include "core/measurements.h"
 #include "core/standstill_detector.h"
 #include "core/static_init.h"
 #include "solver/estimator.h"
+#include "solver/estimator_options.h"
 
 namespace gins {
 
+// A run that cannot produce a trajectory (no standstill, no GNSS, ...). what() is one line.
+class RunError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class Session {
  public:
-  explicit Session(const Options& options);
+  explicit Session(const EstimatorOptions& options);
 
   void AddEstimator(std::unique_ptr<Estimator> estimator);
 
@@ -52,7 +60,7 @@ class Session {
   template <typename F>
   void Dispatch(F&& f);
 
-  Options options_;
+  EstimatorOptions options_;
   std::optional<LocalEnuFrame> frame_;
   double g_norm_ = 0.0;
   std::unique_ptr<StaticInitializer> init_;

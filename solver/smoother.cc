@@ -163,7 +163,7 @@ ceres::ResidualBlockId Smoother::AddFactor(ceres::CostFunction* cost, ceres::Los
   return problem_->AddResidualBlock(new FejCost(cost, std::move(owners)), loss, params);
 }
 
-Smoother::Smoother(const Options& options, StateCallback on_final, StateCallback on_online)
+Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, StateCallback on_online)
     : options_(options), on_final_(std::move(on_final)), on_online_(std::move(on_online)),
       watchdog_(options.watchdog) {
   gnss_gate_ = options_.gnss.gate_probability > 0.0 ? Chi2Quantile(options_.gnss.gate_probability, 3)

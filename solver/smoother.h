@@ -31,7 +31,7 @@
 #include <utility>
 #include <vector>
 
-#include "config/options.h"
+#include "solver/estimator_options.h"
 #include "core/preintegration.h"
 #include "factors/pose_manifold.h"
 #include "solver/estimator.h"
@@ -40,7 +40,7 @@ namespace gins {
 
 class Smoother : public Estimator {
  public:
-  Smoother(const Options& options, StateCallback on_final, StateCallback on_online);
+  Smoother(const EstimatorOptions& options, StateCallback on_final, StateCallback on_online);
   ~Smoother() override;
 
   std::string name() const override { return "smoother"; }
@@ -85,7 +85,7 @@ class Smoother : public Estimator {
   StateEstimate EstimateOf(const Keyframe& kf, const Mat15* cov) const;
   void AddPrior(const Keyframe& kf, const Mat15& P0);
 
-  Options options_;
+  EstimatorOptions options_;
   StateCallback on_final_, on_online_;
   Vec3 g_w_ = Vec3::Zero();
   bool initialized_ = false;

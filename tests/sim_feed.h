@@ -1,7 +1,7 @@
 // Feeding a simulated drive to a Session, as the runner feeds it a log's records.
 #pragma once
 
-#include "core/simulator.h"
+#include "core/sim/simulator.h"
 #include "solver/session.h"
 
 namespace gins::test {

@@ -2,7 +2,7 @@
 #include <benchmark/benchmark.h>
 
 #include "core/imu_kernel.h"
-#include "core/log_reader.h"
+#include "core/io/log_reader.h"
 #include "core/preintegration.h"
 #include "core/so3.h"
 

@@ -7,7 +7,7 @@
 #include <variant>
 #include <vector>
 
-#include "core/simulator.h"
+#include "core/sim/simulator.h"
 #include "solver/eskf.h"
 #include "solver/session.h"
 #include "solver/smoother.h"

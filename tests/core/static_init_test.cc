@@ -11,7 +11,7 @@
 
 #include "core/geodesy.h"
 #include "core/heading_model.h"
-#include "core/simulator.h"
+#include "core/sim/simulator.h"
 #include "core/so3.h"
 #include "core/wheel_model.h"
 #include "test_scenarios.h"

@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "core/log_reader.h"
+#include "core/io/log_reader.h"
 
 namespace {
 

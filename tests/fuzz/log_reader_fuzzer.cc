@@ -10,7 +10,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "core/log_reader.h"
+#include "core/io/log_reader.h"
 
 namespace {
 

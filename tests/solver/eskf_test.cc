@@ -6,7 +6,7 @@
 
 #include "core/chi2.h"
 #include "core/heading_model.h"
-#include "core/simulator.h"
+#include "core/sim/simulator.h"
 #include "core/so3.h"
 #include "solver/session.h"
 #include "sim_feed.h"

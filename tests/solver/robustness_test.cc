@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/geodesy.h"
-#include "core/simulator.h"
+#include "core/sim/simulator.h"
 #include "solver/eskf.h"
 #include "solver/session.h"
 #include "solver/smoother.h"

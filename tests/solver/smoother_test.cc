@@ -11,7 +11,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/simulator.h"
+#include "core/sim/simulator.h"
 #include "core/so3.h"
 #include "solver/eskf.h"
 #include "solver/session.h"

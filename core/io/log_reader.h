@@ -23,10 +23,20 @@
 #include <string_view>
 #include <vector>
 
-#include "config/options.h"
 #include "core/measurements.h"
 
 namespace gins {
+
+enum class InputErrorPolicy { kSkip, kStop };
+
+// input.*
+struct InputOptions {
+  InputErrorPolicy on_error = InputErrorPolicy::kSkip;  // input.on_error: skip | stop
+  int max_errors = 1000;             // input.max_errors: give up after this many skipped lines (skip policy)
+  int max_line_length = 4096;        // input.max_line_length: characters; longer lines are damage
+  double max_time_jump = 60.0;       // input.max_time_jump_s: a record this far ahead of the newest time is
+                                     // damage (time_jump); 0 = no limit
+};
 
 // Bad or unreadable input at the program boundary. what() is one line: "<file>:<line>: <reason>" (or
 // "<file>: <reason>" when no line applies).

@@ -1,4 +1,4 @@
-#include "core/batch_pipe.h"
+#include "core/io/batch_pipe.h"
 
 #include <gtest/gtest.h>
 

@@ -41,15 +41,47 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "config/options.h"
 #include "core/conventions.h"
 #include "core/geodesy.h"
 #include "core/measurements.h"
 #include "core/nav_state.h"
 
 namespace gins {
+
+// simulate.* (only `gins simulate` reads it)
+struct SimSegment {
+  double duration = 0.0;     // s
+  double accel = 0.0;        // m/s², forward
+  double yaw_rate = 0.0;     // rad/s   (yaml: yaw_rate_deg_s)
+  double grade = 0.0;        // rad, road pitch reached at the end of the segment (yaml: grade_deg)
+};
+
+struct SimOptions {
+  unsigned seed = 1;
+  double start_time = 1700000000.0;
+  GeodeticPoint origin{31.5, 120.4, 10.0};
+  double initial_yaw = 0.0;   // rad ENU (yaml: initial_heading_deg, compass)
+  std::vector<SimSegment> segments;
+  unsigned repeat = 1;        // the segment list is driven this many times in a row (long benchmark drives)
+  double imu_rate = 100.0, gnss_rate = 1.0, wheel_rate = 10.0;
+  // True sensor errors.
+  double gyro_noise_density = 0.5 * kDegToRad / 60.0, acc_noise_density = 0.05 / 60.0;
+  double gyro_bias_rw = 10.0 * kDegToRad / 3600.0 / 60.0, acc_bias_rw = 0.002 / 60.0;
+  double gyro_turn_on_bias = 100.0 * kDegToRad / 3600.0, acc_turn_on_bias = 0.03;  // per-axis 1-σ
+  Vec3 gnss_sigma_enu = Vec3(0.02, 0.02, 0.03);
+  bool write_gnss_sigma = true;
+  double heading_sigma = 0.2 * kDegToRad;
+  double heading_invalid_fraction = 0.05;
+  std::vector<std::pair<double, double>> gnss_outages;  // [start (s after start), duration]
+  double gnss_outlier_probability = 0.0, gnss_outlier_magnitude = 20.0;  // m
+  Vec3 lever_b = Vec3(-0.17, -0.20, 0.0);
+  double mount_yaw = 12.06 * kDegToRad;
+  double wheel_radius = 0.155, pulses_per_rev = 1024.0, wheel_scale = 0.99, wheel_speed_noise = 0.02;
+  double track_width = 1.6;
+};
 
 // The true motion at one instant.
 struct TruthState {

@@ -1,6 +1,6 @@
 // Accuracy evaluation against a truth: known answers on constructed trajectories, interpolation of the
 // estimate at the truth times, and the truth file reader (plain and gzip, malformed rows).
-#include "core/evaluation.h"
+#include "core/eval/evaluation.h"
 
 #include <gtest/gtest.h>
 #include <zlib.h>
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "core/log_reader.h"
+#include "core/io/log_reader.h"
 #include "core/so3.h"
 #include "test_util.h"
 

@@ -8,8 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/evaluation.h"
-#include "core/trajectory_metrics.h"
+#include "core/eval/evaluation.h"
+#include "core/eval/trajectory_metrics.h"
 
 namespace gins {
 

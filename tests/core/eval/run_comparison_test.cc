@@ -1,7 +1,7 @@
 // The comparison at the end of a run (solver/run_comparison.h), which streams every file: on a run directory
 // written by the trajectory writers, it gives exactly what the whole-trajectory evaluation (as `gins eval`
 // does it) gives on the same files; it reads nothing it does not compare; damaged files name file and line.
-#include "solver/run_comparison.h"
+#include "core/eval/run_comparison.h"
 
 #include <gtest/gtest.h>
 
@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "core/log_reader.h"
+#include "core/io/log_reader.h"
 #include "core/so3.h"
-#include "core/trajectory_reader.h"
-#include "core/trajectory_writer.h"
+#include "core/io/trajectory_reader.h"
+#include "core/io/trajectory_writer.h"
 #include "test_util.h"
 
 namespace gins {

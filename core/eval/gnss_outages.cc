@@ -1,4 +1,4 @@
-#include "core/gnss_outages.h"
+#include "core/eval/gnss_outages.h"
 
 #include <algorithm>
 #include <cmath>

@@ -35,7 +35,7 @@
 #include <string>
 #include <vector>
 
-#include "core/trajectory_reader.h"
+#include "core/io/trajectory_reader.h"
 
 namespace gins {
 

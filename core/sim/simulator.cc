@@ -1,4 +1,4 @@
-#include "core/simulator.h"
+#include "core/sim/simulator.h"
 
 #include <glog/logging.h>
 
@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "core/trajectory_writer.h"
+#include "core/io/trajectory_writer.h"
 
 namespace gins {
 namespace {

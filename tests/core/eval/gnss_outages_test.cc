@@ -1,6 +1,6 @@
 // Simulated GNSS outage windows (core/gnss_outages.h): membership at the window edges, the periodic pattern,
 // the absolute windows a run reports, and gaps in a log's own GNSS stream.
-#include "core/gnss_outages.h"
+#include "core/eval/gnss_outages.h"
 
 #include <gtest/gtest.h>
 

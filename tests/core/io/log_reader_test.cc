@@ -1,4 +1,4 @@
-#include "core/log_reader.h"
+#include "core/io/log_reader.h"
 
 #include <gtest/gtest.h>
 #include <zlib.h>

@@ -1,4 +1,4 @@
-#include "core/trajectory_writer.h"
+#include "core/io/trajectory_writer.h"
 
 #include <unistd.h>
 
@@ -6,7 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "core/number_format.h"
+#include "core/io/number_format.h"
 
 namespace gins {
 namespace {

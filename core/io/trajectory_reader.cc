@@ -1,4 +1,4 @@
-#include "core/trajectory_reader.h"
+#include "core/io/trajectory_reader.h"
 
 #include <zlib.h>
 
@@ -9,8 +9,8 @@
 #include <map>
 #include <sstream>
 
-#include "core/log_reader.h"
-#include "core/number_format.h"
+#include "core/io/log_reader.h"
+#include "core/io/number_format.h"
 
 namespace gins {
 namespace {

@@ -1,4 +1,4 @@
-#include "solver/run_comparison.h"
+#include "core/eval/run_comparison.h"
 
 #include <cmath>
 #include <filesystem>
@@ -7,7 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "core/trajectory_reader.h"
+#include "core/io/trajectory_reader.h"
 
 namespace gins {
 

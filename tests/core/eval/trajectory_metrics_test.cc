@@ -1,7 +1,7 @@
 // Trajectory metrics (core/trajectory_metrics.h) on constructed trajectories with known answers: offsets,
 // rotations, gaps, alignment recovering a known transform, relative error over distance, outage drift; the
 // streaming evaluator against a whole-trajectory oracle; the median interval.
-#include "core/trajectory_metrics.h"
+#include "core/eval/trajectory_metrics.h"
 
 #include <gtest/gtest.h>
 

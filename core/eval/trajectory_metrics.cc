@@ -1,4 +1,4 @@
-#include "core/trajectory_metrics.h"
+#include "core/eval/trajectory_metrics.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

@@ -1,16 +1,16 @@
 // Reading trajectories back (core/trajectory_reader.h): what TumWriter and StatesCsvWriter write reads back,
 // foreign TUM files, gzip, malformed files (whole and streamed), and re-expressing a trajectory in another
 // ENU frame.
-#include "core/trajectory_reader.h"
+#include "core/io/trajectory_reader.h"
 
 #include <gtest/gtest.h>
 #include <zlib.h>
 
 #include <string>
 
-#include "core/log_reader.h"
+#include "core/io/log_reader.h"
 #include "core/so3.h"
-#include "core/trajectory_writer.h"
+#include "core/io/trajectory_writer.h"
 #include "test_util.h"
 
 namespace gins {

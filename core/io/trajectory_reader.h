@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "core/evaluation.h"
+#include "core/io/truth_reader.h"
 #include "core/geodesy.h"
 
 struct gzFile_s;  // zlib's gzFile

@@ -1,4 +1,4 @@
-#include "core/simulator.h"
+#include "core/sim/simulator.h"
 
 #include <gtest/gtest.h>
 

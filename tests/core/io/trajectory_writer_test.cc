@@ -1,5 +1,5 @@
 // Output files: complete or absent (AtomicFile), and the TUM / state CSV formats read back.
-#include "core/trajectory_writer.h"
+#include "core/io/trajectory_writer.h"
 
 #include <gtest/gtest.h>
 

@@ -1,0 +1,80 @@
+// The sensors' descriptions every estimator and the initialisation share: IMU noise model and axes, GNSS
+// antenna geometry and noise, wheel encoders, gravity model. In SI units with in-class defaults equal to
+// config/default.yaml; config/ fills them from YAML (the comments give each key path and unit).
+#pragma once
+
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "core/conventions.h"
+#include "core/geodesy.h"
+
+namespace gins {
+
+// imu.*
+struct ImuOptions {
+  // imu.axes: FLU | FRD | RFU | matrix (3x3 row-major list) mapping logged axes into the body FLU frame.
+  Mat3 R_b_imu = Mat3::Identity();
+  double gyro_noise_density = 0.8 * kDegToRad / 60.0;   // imu.gyro_noise_deg_sqrt_h → rad/s/√Hz
+  double acc_noise_density = 0.08 / 60.0;                // imu.acc_noise_m_s_sqrt_h → m/s²/√Hz
+  double gyro_bias_rw = 60.0 * kDegToRad / 3600.0 / 60.0;  // imu.gyro_bias_rw_deg_h_sqrt_h → rad/s/√s
+  double acc_bias_rw = 0.01 / 60.0;                      // imu.acc_bias_rw_m_s2_sqrt_h → m/s²/√s
+  double init_gyro_bias_sigma = 300.0 * kDegToRad / 3600.0;  // imu.init_gyro_bias_sigma_deg_h → rad/s
+  double init_acc_bias_sigma = 0.1;                      // imu.init_acc_bias_sigma_m_s2 → m/s²
+  double max_gap = 0.5;                // imu.max_gap_s: a longer IMU gap is not integrated across
+  double max_gyro = 35.0;              // imu.max_gyro_rad_s: larger readings are absurd (damage)
+  double max_acc = 200.0;              // imu.max_acc_m_s2
+};
+
+// gnss.*
+struct GnssOptions {
+  Vec3 lever_b = Vec3(-0.17, -0.20, 0.0);  // gnss.lever_arm_m: antenna position in b
+  double mount_yaw = 12.06 * kDegToRad;    // gnss.mount_yaw_deg: yaw of the antenna baseline frame G in b
+  Vec3 sigma_enu = Vec3(0.05, 0.05, 0.10);  // gnss.sigma_m [e, n, u]: used when a fix carries no σ
+  double min_sigma = 0.005;                // gnss.min_sigma_m: floor for logged σ (a zero σ is not trusted)
+  double heading_sigma = 0.5 * kDegToRad;   // gnss.heading_sigma_deg
+  bool use_heading = true;                 // gnss.use_heading
+  double gate_probability = 0.9999;        // gnss.gate_probability: χ² gate on the innovation (0 = off)
+  std::optional<GeodeticPoint> origin;     // gnss.origin: [lat_deg, lon_deg, alt_m]; absent = first fix
+  // Simulated GNSS outages (fixes in a window are dropped once initialised), times in s after the log's
+  // first record; each window is [start, start + duration).
+  std::vector<std::pair<double, double>> outages;  // gnss.outages_s: [[start_s, duration_s], ...]
+  struct PeriodicOutages {
+    double first_start = 0.0;  // s after the first record
+    double duration = 0.0;     // s; 0 = none
+    double period = 0.0;       // s, start to start
+  };
+  PeriodicOutages periodic_outages;  // gnss.periodic_outages_s: [first_start_s, duration_s, period_s] or []
+};
+
+// wheel.*
+struct WheelOptions {
+  bool enabled = true;              // wheel.enabled
+  double radius = 0.155;            // wheel.radius_m
+  double pulses_per_rev = 1024.0;   // wheel.pulses_per_rev
+  double interval = 0.1;            // wheel.interval_s: pulse counting interval
+  double speed_sigma = 0.1;         // wheel.speed_sigma_m_s
+  double gate_probability = 0.9999; // wheel.gate_probability
+  double scale_sigma = 0.05;        // wheel.scale_sigma: prior 1-σ of the odometer scale (initial value 1)
+  double scale_rw = 1e-4;           // wheel.scale_rw_per_sqrt_s: random walk of the scale
+  bool estimate_scale = true;       // wheel.estimate_scale
+  bool nonholonomic = false;        // wheel.nonholonomic: zero lateral/vertical body speed
+  double nhc_sigma = 0.1;           // wheel.nhc_sigma_m_s
+};
+
+// gravity.*
+struct GravityOptions {
+  bool use_normal_gravity = true;   // gravity.model: normal (WGS84 at the origin) | fixed
+  double magnitude = kStandardGravity;  // gravity.magnitude_m_s2 (model fixed)
+};
+
+// The sensors of a log, as a group.
+struct SensorOptions {
+  ImuOptions imu;
+  GnssOptions gnss;
+  WheelOptions wheel;
+  GravityOptions gravity;
+};
+
+}  // namespace gins

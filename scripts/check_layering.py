@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""Checks that the production libraries include one another in one direction only (docs/architecture.md).
+
+Each source folder is one static library; a file may include headers of its own library and of the
+libraries it is allowed to use, never of a library above it. The allowed sets form a strict order, so the
+include graph between libraries has no cycles. Exits non-zero and names every offending include.
+
+  scripts/check_layering.py [source_root]
+"""
+import os
+import re
+import sys
+
+# Library -> its folder and the libraries it may include (besides itself).
+LAYERS = {
+    "core": ("core", []),
+    "io": ("core/io", ["core"]),
+    "eval": ("core/eval", ["core", "io"]),
+    "sim": ("core/sim", ["core", "io"]),
+    "factors": ("factors", ["core"]),
+    "solver": ("solver", ["core", "io", "eval", "factors"]),
+    "config": ("config", ["core", "io", "eval", "sim", "factors", "solver"]),
+    "apps": ("apps", ["core", "io", "eval", "sim", "factors", "solver", "config"]),
+}
+INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
+
+
+def library_of(path):
+    """The library a header path (relative to the source root) belongs to, or None."""
+    folder = os.path.dirname(path)
+    for name, (lib_folder, _) in LAYERS.items():
+        if folder == lib_folder:
+            return name
+    return None
+
+
+def main():
+    root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..")
+    problems = []
+    for name, (folder, allowed) in LAYERS.items():
+        directory = os.path.join(root, folder)
+        for entry in sorted(os.listdir(directory)):
+            if not entry.endswith((".h", ".cc")):
+                continue
+            path = os.path.join(directory, entry)
+            with open(path, encoding="utf-8") as f:
+                for number, line in enumerate(f, 1):
+                    m = INCLUDE.match(line)
+                    if not m:
+                        continue
+                    target = library_of(m.group(1))
+                    if target is None:
+                        problems.append(f"{folder}/{entry}:{number}: includes {m.group(1)}, which is in no library")
+                    elif target != name and target not in allowed:
+                        problems.append(f"{folder}/{entry}:{number}: {name} may not include {m.group(1)} ({target})")
+    for p in problems:
+        print(p)
+    if problems:
+        return 1
+    print("layering: %d libraries, includes point one way only" % len(LAYERS))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

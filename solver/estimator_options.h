@@ -1,0 +1,46 @@
+// The estimators' options: the sensors and the initialisation (core), the standstill detector, and each
+// estimator's own settings. config/ fills them from YAML; the estimators and the session take them.
+#pragma once
+
+#include <string>
+
+#include "core/standstill_detector.h"
+#include "core/static_init.h"
+
+namespace gins {
+
+// eskf.*
+struct EskfOptions {
+  bool estimate_gravity = true;     // eskf.estimate_gravity: δg in the error state
+  double gravity_sigma = 0.01;      // eskf.gravity_sigma_m_s2 initial 1-σ per axis
+};
+
+// smoother.*
+struct SmootherOptions {
+  int window_size = 10;             // smoother.window_size: keyframes in the window
+  double max_keyframe_interval = 1.0;  // smoother.max_keyframe_interval_s
+  double min_keyframe_interval = 0.5;  // smoother.min_keyframe_interval_s: faster GNSS is decimated
+  std::string linear_solver = "sparse_normal_cholesky";  // smoother.linear_solver: sparse_normal_cholesky | dense_schur
+  int max_iterations = 10;          // smoother.max_iterations
+  double function_tolerance = 1e-6;  // smoother.function_tolerance: stop when |Δcost|/cost falls below
+  int num_threads = 1;              // smoother.num_threads
+  double gnss_loss_scale = 3.0;     // smoother.gnss_loss_scale: Cauchy loss scale on whitened residuals
+  double bias_reintegrate_threshold = 1e-3;  // smoother.bias_reintegrate_threshold (norm of δb)
+};
+
+// watchdog.*: divergence detection and re-initialisation from GNSS.
+struct WatchdogOptions {
+  bool enabled = true;                // watchdog.enabled
+  double max_reject = 15.0;           // watchdog.max_reject_s: every GNSS fix rejected for this long
+  double max_position_sigma = 100.0;  // watchdog.max_position_sigma_m: position 1-σ that counts as exploded
+};
+
+// Everything an estimator (and the session that feeds it) may read.
+struct EstimatorOptions : InitializerOptions {
+  EskfOptions eskf;
+  SmootherOptions smoother;
+  StandstillOptions standstill;
+  WatchdogOptions watchdog;
+};
+
+}  // namespace gins

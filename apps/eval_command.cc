@@ -5,16 +5,18 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "core/eval/evaluation.h"
-#include "core/io/log_reader.h"
+#include "core/eval/run_comparison.h"
 #include "core/eval/trajectory_metrics.h"
+#include "core/io/log_reader.h"
 #include "core/io/trajectory_reader.h"
 #include "core/io/trajectory_writer.h"
-#include "core/eval/run_comparison.h"
 
 namespace gins {
 namespace {
@@ -151,71 +153,141 @@ void PrintTable(const std::string& reference, const std::string& frame_text, Ali
   std::printf("\n");
 }
 
+// The files to evaluate: the inputs, run directories expanded to their outputs. A run directory's summary
+// becomes *summary_path unless one was given.
+std::vector<std::string> ExpandInputs(const std::vector<std::string>& inputs, std::string* summary_path) {
+  std::vector<std::string> files;
+  for (const std::string& in : inputs) {
+    std::error_code ec;
+    if (fs::is_directory(in, ec)) {
+      for (const auto& f : RunDirectoryOutputs(in)) files.push_back(f);
+      if (summary_path->empty() && fs::exists(in + "/summary.json", ec)) *summary_path = in + "/summary.json";
+    } else {
+      files.push_back(in);
+    }
+  }
+  return files;
+}
+
+// The trajectories and the truth (when given) in one evaluation frame: the first trajectory's origin, else
+// the truth's first row. Returns the frame (none without either), and whether a file without an origin was
+// taken to be in it.
+struct Inputs {
+  std::vector<Trajectory> traj;
+  std::vector<TruthSample> truth;
+  std::optional<LocalEnuFrame> frame;
+  bool assumed_frame = false;
+};
+
+Inputs ReadInFrame(const std::vector<std::string>& files, const std::string& truth_path) {
+  Inputs in;
+  for (const std::string& f : files) in.traj.push_back(ReadTrajectory(f));
+  for (const Trajectory& t : in.traj) {
+    if (t.origin) {
+      in.frame.emplace(*t.origin);
+      break;
+    }
+  }
+  if (!truth_path.empty()) {
+    if (in.frame) {
+      in.truth = ReadTruth(truth_path, *in.frame);
+    } else {
+      const LocalEnuFrame earth_centre({0.0, 0.0, 0.0});
+      in.truth = ReadTruth(truth_path, earth_centre);
+      in.frame.emplace(earth_centre.ToGeodetic(in.truth.front().p_w));
+      TruthChangeFrame(earth_centre, *in.frame, &in.truth);
+    }
+  }
+  for (Trajectory& t : in.traj) {
+    if (t.origin && in.frame) {
+      ChangeFrame(LocalEnuFrame(*t.origin), *in.frame, &t);
+    } else if (!t.origin) {
+      in.assumed_frame = true;  // a foreign file: taken to be in the evaluation frame already
+    }
+  }
+  return in;
+}
+
+// Short labels, unique (the path where two would be the same).
+std::vector<std::string> Labels(const std::vector<Trajectory>& traj) {
+  std::vector<std::string> labels;
+  for (const Trajectory& t : traj) labels.push_back(Label(t));
+  for (size_t i = 0; i < labels.size(); ++i) {
+    if (std::count(labels.begin(), labels.end(), labels[i]) > 1) labels[i] = traj[i].path;
+  }
+  return labels;
+}
+
+std::string FrameText(const std::optional<LocalEnuFrame>& frame, bool assumed_frame) {
+  std::string text = "frame ENU";
+  if (frame) {
+    char buf[128];
+    std::snprintf(buf, sizeof(buf), "frame ENU at %.7f %.7f %.3f", frame->origin().lat_deg, frame->origin().lon_deg,
+                  frame->origin().alt_m);
+    text = buf;
+  }
+  if (assumed_frame) text += " (files without an origin taken to be in it)";
+  return text;
+}
+
+// The --json file: every metric, per-outage lists included.
+void WriteJson(const EvalRequest& req, const Inputs& in, size_t reference_samples, const std::string& summary_path,
+               const std::vector<TimeWindow>& outages, double time_origin, Alignment alignment,
+               const std::vector<Row>& rows) {
+  const bool with_truth = !req.truth_path.empty();
+  nlohmann::json j;
+  j["reference"] = {{"kind", with_truth ? "truth" : "trajectory"},
+                    {"path", with_truth ? req.truth_path : in.traj.front().path},
+                    {"samples", reference_samples}};
+  if (in.frame) {
+    j["frame_origin_lla"] = {in.frame->origin().lat_deg, in.frame->origin().lon_deg, in.frame->origin().alt_m};
+  }
+  j["time_origin"] = time_origin;
+  j["summary"] = summary_path.empty() ? nlohmann::json() : nlohmann::json(summary_path);
+  j["alignment"] = AlignmentName(alignment);
+  j["segment_length_m"] = req.segment_length;
+  j["max_gap_s"] = req.max_gap;
+  nlohmann::json ow = nlohmann::json::array();
+  for (const TimeWindow& w : outages) {
+    ow.push_back({{"begin", w.begin}, {"end", w.end}, {"begin_s", w.begin - time_origin}, {"source", w.source}});
+  }
+  j["outage_windows"] = ow;
+  j["trajectories"] = nlohmann::json::array();
+  for (const Row& r : rows) {
+    nlohmann::json t = MetricsToJson(r.m, time_origin);
+    t["name"] = r.label;
+    t["path"] = r.path;
+    t["has_velocity"] = r.has_velocity;
+    j["trajectories"].push_back(t);
+  }
+  const fs::path parent = fs::path(req.json_path).parent_path();
+  std::error_code ec;
+  if (!parent.empty()) fs::create_directories(parent, ec);
+  AtomicFile out(req.json_path);
+  out.Write(j.dump(2) + "\n");
+  out.Commit();
+  std::printf("\nwrote %s\n", req.json_path.c_str());
+}
+
 int Evaluate(const EvalRequest& req) {
   if (req.segment_length <= 0.0) throw UsageError("--segment-length must be > 0");
   if (req.max_gap <= 0.0) throw UsageError("--max-gap must be > 0");
   const Alignment alignment = ParseAlignment(req.align);
 
   // Inputs: files, or run directories (their outputs, and their summary unless --summary is given).
-  std::vector<std::string> files;
   std::string summary_path = req.summary_path;
-  for (const std::string& in : req.inputs) {
-    std::error_code ec;
-    if (fs::is_directory(in, ec)) {
-      for (const auto& f : RunDirectoryOutputs(in)) files.push_back(f);
-      if (summary_path.empty() && fs::exists(in + "/summary.json", ec)) summary_path = in + "/summary.json";
-    } else {
-      files.push_back(in);
-    }
-  }
+  const std::vector<std::string> files = ExpandInputs(req.inputs, &summary_path);
   const bool with_truth = !req.truth_path.empty();
   if (!with_truth && files.size() < 2) {
     throw UsageError("give --truth FILE, or at least two trajectories (the first is the reference)");
   }
-
-  std::vector<Trajectory> traj;
-  for (const std::string& f : files) traj.push_back(ReadTrajectory(f));
-
-  // One evaluation frame: the first trajectory's origin, else the truth's first row.
-  std::optional<LocalEnuFrame> frame;
-  for (const Trajectory& t : traj) {
-    if (t.origin) {
-      frame.emplace(*t.origin);
-      break;
-    }
-  }
-  std::vector<TruthSample> truth;
-  if (with_truth) {
-    if (frame) {
-      truth = ReadTruth(req.truth_path, *frame);
-    } else {
-      const LocalEnuFrame earth_centre({0.0, 0.0, 0.0});
-      truth = ReadTruth(req.truth_path, earth_centre);
-      frame.emplace(earth_centre.ToGeodetic(truth.front().p_w));
-      TruthChangeFrame(earth_centre, *frame, &truth);
-    }
-  }
-  bool assumed_frame = false;
-  for (Trajectory& t : traj) {
-    if (t.origin && frame) {
-      ChangeFrame(LocalEnuFrame(*t.origin), *frame, &t);
-    } else if (!t.origin) {
-      assumed_frame = true;  // a foreign file: taken to be in the evaluation frame already
-    }
-  }
-
-  // Labels, unique.
-  std::vector<std::string> labels;
-  for (const Trajectory& t : traj) labels.push_back(Label(t));
-  for (size_t i = 0; i < labels.size(); ++i) {
-    if (std::count(labels.begin(), labels.end(), labels[i]) > 1) labels[i] = traj[i].path;
-  }
+  const Inputs in = ReadInFrame(files, req.truth_path);
+  const std::vector<std::string> labels = Labels(in.traj);
 
   std::vector<TimeWindow> outages;
-  double time_origin = with_truth ? truth.front().t : traj.front().samples.front().t;
-  nlohmann::json summary;
+  double time_origin = with_truth ? in.truth.front().t : in.traj.front().samples.front().t;
   if (!summary_path.empty()) {
-    summary = ReadJsonFile(summary_path);
+    const nlohmann::json summary = ReadJsonFile(summary_path);
     outages = OutageWindowsFromSummary(summary);
     if (summary.contains("input") && summary["input"].contains("first_time") &&
         summary["input"]["first_time"].is_number()) {
@@ -229,74 +301,30 @@ int Evaluate(const EvalRequest& req) {
   options.alignment = alignment;
   options.outages = outages;
 
-  std::vector<TrajectorySample> reference;
-  bool reference_velocity = true;
-  std::string reference_text;
-  size_t first_estimate = 0;
-  if (with_truth) {
-    reference = ToTrajectorySamples(truth);
-    reference_text = "truth " + req.truth_path;
-  } else {
-    reference = traj.front().samples;
-    reference_velocity = traj.front().has_velocity;
-    reference_text = labels.front() + " (" + traj.front().path + ")";
-    first_estimate = 1;
-  }
+  // The reference: the truth, else the first trajectory (then not an estimate).
+  const std::vector<TrajectorySample> reference =
+      with_truth ? ToTrajectorySamples(in.truth) : in.traj.front().samples;
+  const bool reference_velocity = with_truth || in.traj.front().has_velocity;
+  const std::string reference_text = with_truth ? "truth " + req.truth_path
+                                                : labels.front() + " (" + in.traj.front().path + ")";
   std::vector<Row> rows;
-  for (size_t i = first_estimate; i < traj.size(); ++i) {
+  for (size_t i = with_truth ? 0 : 1; i < in.traj.size(); ++i) {
     Row r;
     r.label = labels[i];
-    r.path = traj[i].path;
-    r.has_velocity = traj[i].has_velocity;
+    r.path = in.traj[i].path;
+    r.has_velocity = in.traj[i].has_velocity;
     try {
-      r.m = EvaluateTrajectory(reference, reference_velocity, traj[i].samples, traj[i].has_velocity, options);
+      r.m = EvaluateTrajectory(reference, reference_velocity, in.traj[i].samples, in.traj[i].has_velocity, options);
     } catch (const std::invalid_argument& e) {
-      throw InputError(traj[i].path + ": " + e.what());
+      throw InputError(in.traj[i].path + ": " + e.what());
     }
     rows.push_back(r);
   }
 
-  std::string frame_text = "frame ENU";
-  if (frame) {
-    char buf[128];
-    std::snprintf(buf, sizeof(buf), "frame ENU at %.7f %.7f %.3f", frame->origin().lat_deg, frame->origin().lon_deg,
-                  frame->origin().alt_m);
-    frame_text = buf;
-  }
-  if (assumed_frame) frame_text += " (files without an origin taken to be in it)";
-  PrintTable(reference_text, frame_text, alignment, rows, outages, time_origin, req.segment_length);
-
+  PrintTable(reference_text, FrameText(in.frame, in.assumed_frame), alignment, rows, outages, time_origin,
+             req.segment_length);
   if (!req.json_path.empty()) {
-    nlohmann::json j;
-    j["reference"] = {{"kind", with_truth ? "truth" : "trajectory"},
-                      {"path", with_truth ? req.truth_path : traj.front().path},
-                      {"samples", reference.size()}};
-    if (frame) j["frame_origin_lla"] = {frame->origin().lat_deg, frame->origin().lon_deg, frame->origin().alt_m};
-    j["time_origin"] = time_origin;
-    j["summary"] = summary_path.empty() ? nlohmann::json() : nlohmann::json(summary_path);
-    j["alignment"] = AlignmentName(alignment);
-    j["segment_length_m"] = req.segment_length;
-    j["max_gap_s"] = req.max_gap;
-    nlohmann::json ow = nlohmann::json::array();
-    for (const TimeWindow& w : outages) {
-      ow.push_back({{"begin", w.begin}, {"end", w.end}, {"begin_s", w.begin - time_origin}, {"source", w.source}});
-    }
-    j["outage_windows"] = ow;
-    j["trajectories"] = nlohmann::json::array();
-    for (const Row& r : rows) {
-      nlohmann::json t = MetricsToJson(r.m, time_origin);
-      t["name"] = r.label;
-      t["path"] = r.path;
-      t["has_velocity"] = r.has_velocity;
-      j["trajectories"].push_back(t);
-    }
-    const fs::path parent = fs::path(req.json_path).parent_path();
-    std::error_code ec;
-    if (!parent.empty()) fs::create_directories(parent, ec);
-    AtomicFile out(req.json_path);
-    out.Write(j.dump(2) + "\n");
-    out.Commit();
-    std::printf("\nwrote %s\n", req.json_path.c_str());
+    WriteJson(req, in, reference.size(), summary_path, outages, time_origin, alignment, rows);
   }
   return 0;
 }

@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/eval/evaluation.h"
+#include "core/eval/trajectory_metrics.h"
 #include "core/io/log_reader.h"
 #include "solver/estimator_options.h"
 #include "solver/session.h"
@@ -32,8 +32,11 @@ struct RunRequest {
 
 struct RunResult {
   nlohmann::json summary;
-  std::vector<std::string> outputs;                  // files written
-  std::map<std::string, AccuracyMetrics> accuracy;   // per output stream, when a truth was given
+  std::vector<std::string> outputs;  // files written
+  // Per output stream against the truth, when one was given: the committed output read back and scored
+  // like `gins eval` scores it (core/eval/trajectory_metrics.h); summary.json's "accuracy". Streams
+  // with nothing to evaluate, or all of them when the comparison failed, are absent.
+  std::map<std::string, TrajectoryMetrics> accuracy;
 };
 
 // Throws InputError (bad log), RunError (no solution possible) or std::runtime_error (I/O). Nothing is

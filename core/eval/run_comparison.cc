@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/io/trajectory_reader.h"
+#include "core/io/truth_reader.h"
 
 namespace gins {
 
@@ -89,13 +90,14 @@ std::string StreamFile(const std::string& dir, const std::string& name) {
 
 namespace {
 
+SampleSource ReaderSource(TrajectoryReader* reader) {
+  return [reader](TrajectorySample* s) { return reader->Next(s); };
+}
+
 // The gap interpolated across for a trajectory file: a first pass over it for its median interval.
 double FileMaxGap(const std::string& path, double max_gap) {
   TrajectoryReader reader(path);
-  IntervalMedian intervals;
-  TrajectorySample s;
-  while (reader.Next(&s)) intervals.Add(s.t);
-  return EffectiveMaxGap(intervals, max_gap);
+  return EffectiveMaxGap(ReaderSource(&reader), max_gap);
 }
 
 struct Outcome {
@@ -116,8 +118,8 @@ std::vector<Outcome> EvaluateAgainst(const SampleSource& reference, bool referen
   for (const std::string& name : names) {
     readers.push_back(std::make_unique<TrajectoryReader>(files.at(name)));
     TrajectoryReader* reader = readers.back().get();
-    evaluators.emplace_back([reader](TrajectorySample* s) { return reader->Next(s); },
-                            reference_has_velocity && reader->has_velocity(), max_gaps.at(name), options);
+    evaluators.emplace_back(ReaderSource(reader), reference_has_velocity && reader->has_velocity(),
+                            max_gaps.at(name), options);
   }
   TrajectorySample ref;
   while (reference(&ref)) {
@@ -137,13 +139,80 @@ std::vector<Outcome> EvaluateAgainst(const SampleSource& reference, bool referen
   return out;
 }
 
+// Every output against the truth: j["vs_truth"], j["best_horizontal"], and the metrics into *vs_truth.
+void CompareWithTruth(const TruthFile& truth, const std::vector<std::string>& names,
+                      const std::map<std::string, std::string>& files, const std::map<std::string, double>& max_gaps,
+                      const MetricOptions& options, double time_origin, nlohmann::json* j,
+                      std::map<std::string, TrajectoryMetrics>* vs_truth) {
+  TruthReader reader(truth.path, truth.frame);
+  const SampleSource reference = [&reader](TrajectorySample* s) {
+    TruthSample x;
+    if (!reader.Next(&x)) return false;
+    *s = ToTrajectorySample(x);
+    return true;
+  };
+  double best = 0.0;
+  for (const Outcome& o : EvaluateAgainst(reference, true, names, files, max_gaps, options)) {
+    if (!o.metrics) {
+      (*j)["vs_truth"][o.name] = {{"error", o.error}};
+      continue;
+    }
+    (*j)["vs_truth"][o.name] = MetricsToJson(*o.metrics, time_origin);
+    if (vs_truth != nullptr) (*vs_truth)[o.name] = *o.metrics;
+    // The causal smoother output is not a competitor of the final one: rank the estimators' main outputs.
+    if (o.name != "smoother_online" && (!j->contains("best_horizontal") || o.metrics->rmse_h < best)) {
+      best = o.metrics->rmse_h;
+      (*j)["best_horizontal"] = o.name;
+    }
+  }
+}
+
+// The outputs other than the ESKF's against it: j["<name>_vs_eskf"].
+void CompareWithEskf(const std::vector<std::string>& others, const std::map<std::string, std::string>& files,
+                     const std::map<std::string, double>& max_gaps, const MetricOptions& options, double time_origin,
+                     nlohmann::json* j) {
+  TrajectoryReader eskf(files.at("eskf"));
+  for (const Outcome& o : EvaluateAgainst(ReaderSource(&eskf), eskf.has_velocity(), others, files, max_gaps, options)) {
+    if (!o.metrics) {
+      (*j)[o.name + "_vs_eskf"] = {{"error", o.error}};
+      continue;
+    }
+    const TrajectoryMetrics& m = *o.metrics;
+    nlohmann::json d;
+    d["samples"] = m.samples;
+    d["rms_horizontal_difference_m"] = m.rmse_h;
+    d["max_horizontal_difference_m"] = m.max_h;
+    d["max_horizontal_difference_time_s"] = m.t_max_h - time_origin;
+    d["rms_vertical_difference_m"] = m.rmse_v;
+    d["rms_heading_difference_deg"] = m.rmse_heading_deg;
+    d["rms_attitude_difference_deg"] = m.rmse_att_deg;
+    if (m.rmse_vel) d["rms_velocity_difference_m_s"] = *m.rmse_vel;
+    if (m.outages_scored) d["largest_horizontal_difference_in_outages_m"] = m.outage_max;
+    (*j)[o.name + "_vs_eskf"] = d;
+  }
+}
+
 }  // namespace
 
-nlohmann::json CompareRunOutputs(const std::string& out_dir, const std::vector<std::string>& streams,
-                                 const TruthFile* truth, const std::vector<TimeWindow>& outages,
-                                 double time_origin) {
+nlohmann::json AccuracyToJson(const TrajectoryMetrics* m) {
+  auto number = [m](double v) { return m ? nlohmann::json(v) : nlohmann::json(); };
   nlohmann::json j;
-  MetricOptions options;
+  j["samples"] = m ? m->samples : 0;
+  j["rmse_3d_m"] = number(m ? m->rmse_3d : 0.0);
+  j["rmse_horizontal_m"] = number(m ? m->rmse_h : 0.0);
+  j["rmse_vertical_m"] = number(m ? m->rmse_v : 0.0);
+  j["max_horizontal_m"] = number(m ? m->max_h : 0.0);
+  j["rmse_velocity_m_s"] = m && m->rmse_vel ? nlohmann::json(*m->rmse_vel) : nlohmann::json();
+  j["rmse_heading_deg"] = number(m ? m->rmse_heading_deg : 0.0);
+  j["rmse_attitude_deg"] = number(m ? m->rmse_att_deg : 0.0);
+  return j;
+}
+
+nlohmann::json CompareRunOutputs(const std::string& out_dir, const std::vector<std::string>& streams,
+                                 const TruthFile* truth, const std::vector<TimeWindow>& outages, double time_origin,
+                                 std::map<std::string, TrajectoryMetrics>* vs_truth) {
+  nlohmann::json j;
+  MetricOptions options;  // also for the differences from the ESKF: over the whole run, outages included
   options.outages = outages;
   // In name order (eskf, smoother, smoother_online), which also breaks ties of best_horizontal.
   std::map<std::string, std::string> files;
@@ -159,52 +228,8 @@ nlohmann::json CompareRunOutputs(const std::string& out_dir, const std::vector<s
   for (const std::string& name : names) {
     if (truth != nullptr || (with_eskf && name != "eskf")) max_gaps[name] = FileMaxGap(files.at(name), options.max_gap);
   }
-  if (truth != nullptr) {
-    TruthReader reader(truth->path, truth->frame);
-    const SampleSource reference = [&reader](TrajectorySample* s) {
-      TruthSample x;
-      if (!reader.Next(&x)) return false;
-      *s = ToTrajectorySample(x);
-      return true;
-    };
-    double best = 0.0;
-    for (const Outcome& o : EvaluateAgainst(reference, true, names, files, max_gaps, options)) {
-      if (!o.metrics) {
-        j["vs_truth"][o.name] = {{"error", o.error}};
-        continue;
-      }
-      j["vs_truth"][o.name] = MetricsToJson(*o.metrics, time_origin);
-      // The causal smoother output is not a competitor of the final one: rank the estimators' main outputs.
-      if (o.name != "smoother_online" && (!j.contains("best_horizontal") || o.metrics->rmse_h < best)) {
-        best = o.metrics->rmse_h;
-        j["best_horizontal"] = o.name;
-      }
-    }
-  }
-  if (with_eskf) {
-    TrajectoryReader eskf(files.at("eskf"));
-    const SampleSource reference = [&eskf](TrajectorySample* s) { return eskf.Next(s); };
-    MetricOptions diff;  // differences over the whole run, outages included
-    diff.outages = outages;
-    for (const Outcome& o : EvaluateAgainst(reference, eskf.has_velocity(), others, files, max_gaps, diff)) {
-      if (!o.metrics) {
-        j[o.name + "_vs_eskf"] = {{"error", o.error}};
-        continue;
-      }
-      const TrajectoryMetrics& m = *o.metrics;
-      nlohmann::json d;
-      d["samples"] = m.samples;
-      d["rms_horizontal_difference_m"] = m.rmse_h;
-      d["max_horizontal_difference_m"] = m.max_h;
-      d["max_horizontal_difference_time_s"] = m.t_max_h - time_origin;
-      d["rms_vertical_difference_m"] = m.rmse_v;
-      d["rms_heading_difference_deg"] = m.rmse_heading_deg;
-      d["rms_attitude_difference_deg"] = m.rmse_att_deg;
-      if (m.rmse_vel) d["rms_velocity_difference_m_s"] = *m.rmse_vel;
-      if (m.outages_scored) d["largest_horizontal_difference_in_outages_m"] = m.outage_max;
-      j[o.name + "_vs_eskf"] = d;
-    }
-  }
+  if (truth != nullptr) CompareWithTruth(*truth, names, files, max_gaps, options, time_origin, &j, vs_truth);
+  if (with_eskf) CompareWithEskf(others, files, max_gaps, options, time_origin, &j);
   return j;
 }
 

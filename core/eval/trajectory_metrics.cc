@@ -125,10 +125,15 @@ double EffectiveMaxGap(const IntervalMedian& estimate_intervals, double max_gap)
   return median ? std::max(max_gap, kMedianGapFactor * *median) : max_gap;
 }
 
-double EffectiveMaxGap(const std::vector<TrajectorySample>& estimate, double max_gap) {
+double EffectiveMaxGap(SampleSource estimate, double max_gap) {
   IntervalMedian intervals;
-  for (const TrajectorySample& s : estimate) intervals.Add(s.t);
+  TrajectorySample s;
+  while (estimate(&s)) intervals.Add(s.t);
   return EffectiveMaxGap(intervals, max_gap);
+}
+
+double EffectiveMaxGap(const std::vector<TrajectorySample>& estimate, double max_gap) {
+  return EffectiveMaxGap(VectorSource(estimate), max_gap);
 }
 
 EstimateMatcher::EstimateMatcher(SampleSource estimate, double max_gap)

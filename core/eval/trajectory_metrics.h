@@ -25,7 +25,8 @@
 //
 // Without alignment everything is computed in one pass over the reference and the estimate, both streamed
 // (TrajectoryEvaluator), after a first pass over the estimate for its median interval: memory does not grow
-// with the log, so `gins run` can compare hours of IMU-rate outputs.
+// with the log, so `gins run` can score hours of IMU-rate outputs. This is the only evaluator: `gins eval`,
+// and `gins run`'s "accuracy" and "comparison" (core/eval/run_comparison.h, from the committed outputs).
 #pragma once
 
 #include <deque>
@@ -77,8 +78,11 @@ class IntervalMedian {
 
 // The gap interpolated across is at least this many times the estimate's median sample interval.
 constexpr double kMedianGapFactor = 3.0;
-// max(max_gap, kMedianGapFactor × median interval of the estimate).
+// max(max_gap, kMedianGapFactor × median interval of the estimate): the one gap rule of every evaluation
+// (`gins eval`, and `gins run`'s accuracy and comparison). The source and vector forms are a first pass over
+// the estimate.
 double EffectiveMaxGap(const IntervalMedian& estimate_intervals, double max_gap);
+double EffectiveMaxGap(SampleSource estimate, double max_gap);
 double EffectiveMaxGap(const std::vector<TrajectorySample>& estimate, double max_gap);
 
 enum class Alignment { kNone, kYaw, kSe3 };

@@ -1,12 +1,14 @@
-// The comparison at the end of a run (solver/run_comparison.h), which streams every file: on a run directory
-// written by the trajectory writers, it gives exactly what the whole-trajectory evaluation (as `gins eval`
-// does it) gives on the same files; it reads nothing it does not compare; damaged files name file and line.
+// The comparison at the end of a run (core/eval/run_comparison.h), which streams every file: on a run
+// directory written by the trajectory writers, it gives exactly what the whole-trajectory evaluation (as
+// `gins eval` does it) gives on the same files, and the run's "accuracy" is its scores against the truth;
+// it reads nothing it does not compare; damaged files name file and line.
 #include "core/eval/run_comparison.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -137,6 +139,46 @@ TEST(CompareRunOutputs, StreamedEqualsWholeTrajectoryEvaluation) {
   EXPECT_LT(c["vs_truth"]["eskf"]["samples"].get<int>(), c["vs_truth"]["eskf"]["reference_samples_in_span"].get<int>());
   EXPECT_EQ(c["vs_truth"]["eskf"]["outages_scored"].get<int>(), 4);
   EXPECT_EQ(c["best_horizontal"], "smoother");
+}
+
+// `gins run`'s "accuracy" is this comparison: the metrics handed back are those of "vs_truth", and the
+// short form carries the same numbers under the same keys. A keyframe-rate output whose keyframes are
+// 1.1 s apart through the drift window [200, 230] s is scored all through it (3 × its 1 s median), where
+// a fixed 1 s left it out.
+TEST(CompareRunOutputs, AccuracyIsTheComparisonAgainstTheTruth) {
+  const RunDir run = WriteRunDirectory("run_comparison_accuracy");
+  {
+    TumWriter online(run.dir + "/smoother_online.tum", "smoother_online", kOrigin);
+    // Off the truth's 0.02 s grid, so no keyframe coincides with a truth time.
+    for (double s = 2.01; s <= 298.0; s += s >= 200.0 && s < 230.0 ? 1.1 : 1.0) online.Add(EstimateAt(s, 0.6));
+    online.Commit();
+  }
+  const std::vector<std::string> names = {"eskf", "smoother", "smoother_online"};
+  const TruthFile truth{run.truth, LocalEnuFrame(kOrigin)};
+  std::map<std::string, TrajectoryMetrics> accuracy;
+  const nlohmann::json c = CompareRunOutputs(run.dir, names, &truth, kOutages, kT0, &accuracy);
+  ASSERT_EQ(accuracy.size(), names.size());
+  for (const std::string& name : names) {
+    SCOPED_TRACE(name);
+    EXPECT_EQ(MetricsToJson(accuracy.at(name), kT0), c["vs_truth"][name]);
+    const nlohmann::json a = AccuracyToJson(&accuracy.at(name));
+    EXPECT_EQ(a.size(), 8u);
+    for (const auto& [key, value] : a.items()) EXPECT_EQ(value, c["vs_truth"][name][key]) << key;
+  }
+  const TrajectoryMetrics& online = accuracy.at("smoother_online");
+  EXPECT_NEAR(online.max_gap, 3.0, 1e-5);
+  EXPECT_EQ(online.samples, online.reference_in_span);
+  ASSERT_EQ(online.outages.size(), kOutages.size());
+  EXPECT_EQ(online.outages[3].samples, 1501u);  // 50 Hz over [200, 230] s
+  EXPECT_GT(online.outages[3].max_h, 0.5);      // the drift there (0.6 × 1.8 m at its end) counts
+  // The former fixed 1 s: at most the window's first truth time.
+  const Trajectory file = ReadTrajectory(StreamFile(run.dir, "smoother_online"));
+  size_t in_window_1s = 0;
+  for (const MatchedPair& p :
+       MatchAtReferenceTimes(ToTrajectorySamples(ReadTruth(run.truth, truth.frame)), file.samples, 1.0)) {
+    in_window_1s += p.ref.t >= kT0 + 200.0 && p.ref.t <= kT0 + 230.0;
+  }
+  EXPECT_LE(in_window_1s, 1u);
 }
 
 // Only the smoother's outputs and no truth: nothing to compare (comparisons are against the truth or the

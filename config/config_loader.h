@@ -1,15 +1,16 @@
 // The YAML front door: the only code in gins that reads YAML.
 //
-// Every key is optional (a missing key keeps the in-class default of config/options.h). Anything else that
-// is not exactly right is an error: unknown keys (with a did-you-mean), duplicate keys, wrong types, wrong
-// list lengths, NaN/inf, out-of-range values, unknown enum strings. Errors are thrown as ConfigError with a
-// message of the form "<file>: <key.path>: <reason> (line N)", so a user can fix the file without reading
-// code. Users' units (named by each key's suffix, e.g. `_deg_sqrt_h`) are converted to SI here, once.
-// config/default.yaml documents every key.
+// Every key is optional (a missing key keeps the in-class default of its option struct, config/options.h).
+// Anything else that is not exactly right is an error: unknown keys (with a did-you-mean), duplicate keys,
+// wrong types, wrong list lengths, NaN/inf, out-of-range values, unknown enum strings. Errors are thrown as
+// ConfigError with a message of the form "<file>: <key.path>: <reason> (line N)", so a user can fix the file
+// without reading code. Users' units (named by each key's suffix, e.g. `_deg_sqrt_h`) are converted to SI
+// here, once. Each key is declared once, in config/config_keys.h; config/default.yaml documents every key.
 #pragma once
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "config/options.h"
 
@@ -31,5 +32,9 @@ Options LoadOptionsFromString(const std::string& yaml, const std::string& name_f
 // with the fewest digits that load back to the identical double, so LoadOptionsFromString(OptionsToYaml(o))
 // reproduces o bit for bit whenever o itself came from a config file or from the defaults.
 std::string OptionsToYaml(const Options& o);
+
+// Every key path a config file may hold, in file order: sections ("imu"), their keys ("imu.axes") and the
+// keys of the items of a list ("simulate.segments[].duration_s").
+std::vector<std::string> ConfigKeys();
 
 }  // namespace gins

@@ -89,7 +89,7 @@ Trajectory ReadTrajectory(const std::string& path);
 // Earth, so this is one rotation and one translation (exact, not a small-distance approximation).
 void ChangeFrame(const LocalEnuFrame& from, const LocalEnuFrame& to, Trajectory* trajectory);
 
-// Truth samples (core/evaluation.h) as trajectory samples, with velocity.
+// Truth samples (core/io/truth_reader.h) as trajectory samples, with velocity.
 TrajectorySample ToTrajectorySample(const TruthSample& truth);
 std::vector<TrajectorySample> ToTrajectorySamples(const std::vector<TruthSample>& truth);
 

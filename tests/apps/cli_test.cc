@@ -226,8 +226,8 @@ TEST_F(CliRun, RunSmootherWithoutTruthComparesNothing) {
   EXPECT_FALSE(s.contains("accuracy"));
 }
 
-// The truth streams in as the estimates advance, but it is read through once when the first state needs
-// it, so a damaged row near its end stops the run before the processing, naming file and line; no files.
+// The truth is read through once when the first state needs it, so a damaged row near its end stops the
+// run before the processing, naming file and line; no files.
 TEST_F(CliRun, DamagedTruthStopsTheRunAndNamesTheLine) {
   ASSERT_EQ(sim_exit_, 0);
   std::vector<std::string> lines = Lines(test::ReadFile(truth_));

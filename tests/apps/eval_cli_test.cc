@@ -266,9 +266,7 @@ TEST(EvalRoundTrip, RunWithOutagesThenEval) {
     EXPECT_DOUBLE_EQ(t["rmse_horizontal_m"].get<double>(),
                      c["vs_truth"][name]["rmse_horizontal_m"].get<double>());
     EXPECT_DOUBLE_EQ(t["outage_drift_rms_m"].get<double>(), c["vs_truth"][name]["outage_drift_rms_m"].get<double>());
-    // And close to the streaming evaluation during the run (full-precision states vs 5-decimal files) for
-    // the IMU-rate outputs (the keyframe-rate smoother_online is interpolated across its ~1 s intervals
-    // here, not by the streaming evaluator).
+    // And the run's own accuracy section, which is now the same comparison (one evaluator).
     if (name != "smoother_online") {
       EXPECT_NEAR(t["rmse_horizontal_m"].get<double>(), s["accuracy"][name]["rmse_horizontal_m"].get<double>(),
                   1e-4 + 1e-3 * s["accuracy"][name]["rmse_horizontal_m"].get<double>());

@@ -5,16 +5,19 @@
 namespace gins {
 
 Kinematics ImuStep(const Kinematics& x, const Vec3& omega, const Vec3& acc, const Vec3& g_w, double dt,
-                   ImuStepJacobians* J) {
+                   ImuStepJacobians* J, const Vec3& earth_rate_w) {
   const Mat3 R = x.q.toRotationMatrix();
-  const Vec3 a_w = R * acc + g_w;
+  const bool rotating = !earth_rate_w.isZero(0.0);
+  Vec3 a_w = R * acc + g_w;
+  if (rotating) a_w -= 2.0 * earth_rate_w.cross(x.v);
   const Vec3 phi = omega * dt;
   const Quat dq = ExpQuat<double>(phi);
 
   Kinematics y;
   y.p = x.p + x.v * dt + 0.5 * a_w * dt * dt;
   y.v = x.v + a_w * dt;
-  y.q = (x.q * dq).normalized();
+  // The left factor turns w under the body; a right perturbation of R passes through it unchanged.
+  y.q = rotating ? (ExpQuat<double>(Vec3(-earth_rate_w * dt)) * x.q * dq).normalized() : (x.q * dq).normalized();
 
   if (J != nullptr) {
     const double dt2 = 0.5 * dt * dt;
@@ -34,6 +37,13 @@ Kinematics ImuStep(const Kinematics& x, const Vec3& omega, const Vec3& acc, cons
     J->G.setZero();
     J->G.block<3, 3>(0, 0) = I * dt2;
     J->G.block<3, 3>(3, 0) = I * dt;
+    J->coriolis = rotating;
+    if (rotating) {
+      // ∂(−2ω_ie×v)/∂v = −2[ω_ie]×, entering v' over dt and p' over ½dt².
+      const Mat3 C = -2.0 * Hat<double>(earth_rate_w);
+      J->A.block<3, 3>(0, 3) += C * dt2;
+      J->A.block<3, 3>(3, 3) += C * dt;
+    }
   }
   return y;
 }

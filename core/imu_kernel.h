@@ -3,6 +3,9 @@
 //
 // Over one interval dt with bias-corrected rate ω and specific force a held constant (first order):
 //   p' = p + v·dt + ½(R·a + g)·dt²,   v' = v + (R·a + g)·dt,   R' = R·Exp(ω·dt).
+// With Earth rotation (core/earth.h: w is Earth-fixed, ω = ω_ib is measured against inertial space and
+// ω_ie is constant in w), the acceleration gains the Coriolis term and w turns under the body:
+//   a_w = R·a + g − 2·ω_ie×v,   p' = p + v·dt + ½a_w·dt²,   v' = v + a_w·dt,   R' = Exp(−ω_ie·dt)·R·Exp(ω·dt).
 // Error state (right perturbation, DESIGN §2), order δp, δv, δθ:
 //   δx' = A·δx + B·[δbg; δba] + B·[ηg; ηa] + G·δg
 // where ηg, ηa are the sensor white noises over the interval (rad/s, m/s²; discrete variance σ²/dt for
@@ -18,6 +21,7 @@ struct ImuStepJacobians {
   Mat9 A;                          // ∂δx'/∂δx
   Eigen::Matrix<double, 9, 6> B;   // ∂δx'/∂[δbg, δba]  (also the noise Jacobian)
   Eigen::Matrix<double, 9, 3> G;   // ∂δx'/∂δg
+  bool coriolis = false;           // A's δv columns carry the Coriolis terms (else they are I·dt and I)
 };
 
 // Kinematic part of the state that the kernel propagates.
@@ -27,21 +31,30 @@ struct Kinematics {
   Vec3 p = Vec3::Zero();
 };
 
-// One step. omega and acc are already bias-corrected. J may be null.
+// One step. omega and acc are already bias-corrected. J may be null. earth_rate_w: ω_ie in w (zero: the
+// flat, non-rotating model).
 Kinematics ImuStep(const Kinematics& x, const Vec3& omega, const Vec3& acc, const Vec3& g_w, double dt,
-                   ImuStepJacobians* J = nullptr);
+                   ImuStepJacobians* J = nullptr, const Vec3& earth_rate_w = Vec3::Zero());
 
 // Products with the step Jacobians that skip their zero and identity blocks (as ImuStep fills them): the
 // ESKF's covariance propagation at IMU rate is made of these. X has the rows δp, δv, δθ; Y has the rows
 // δbg, δba, δg. MulA(J, X) = A·X; MulBG(J, Y, with_gravity) = [B G]·Y (G's part only if with_gravity).
 template <int N>
 Eigen::Matrix<double, 9, N> MulA(const ImuStepJacobians& J, const Eigen::Matrix<double, 9, N>& X) {
-  const double dt = J.A(0, 3);
+  const auto Xv = X.template middleRows<3>(3);
   const auto Xt = X.template middleRows<3>(6);
   Eigen::Matrix<double, 9, N> out;
-  out.template middleRows<3>(0) = X.template middleRows<3>(0) + dt * X.template middleRows<3>(3) +
-                                  J.A.template block<3, 3>(0, 6).lazyProduct(Xt);
-  out.template middleRows<3>(3) = X.template middleRows<3>(3) + J.A.template block<3, 3>(3, 6).lazyProduct(Xt);
+  if (J.coriolis) {
+    out.template middleRows<3>(0) = X.template middleRows<3>(0) + J.A.template block<3, 3>(0, 3).lazyProduct(Xv) +
+                                    J.A.template block<3, 3>(0, 6).lazyProduct(Xt);
+    out.template middleRows<3>(3) =
+        J.A.template block<3, 3>(3, 3).lazyProduct(Xv) + J.A.template block<3, 3>(3, 6).lazyProduct(Xt);
+  } else {
+    const double dt = J.A(0, 3);
+    out.template middleRows<3>(0) =
+        X.template middleRows<3>(0) + dt * Xv + J.A.template block<3, 3>(0, 6).lazyProduct(Xt);
+    out.template middleRows<3>(3) = Xv + J.A.template block<3, 3>(3, 6).lazyProduct(Xt);
+  }
   out.template middleRows<3>(6) = J.A.template block<3, 3>(6, 6).lazyProduct(Xt);
   return out;
 }

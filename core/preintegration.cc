@@ -80,6 +80,28 @@ Preintegration::Delta Preintegration::Corrected(const Vec3& bg, const Vec3& ba) 
   return d;
 }
 
+Quat ImuEarthTerms::Turn(const Vec3& rate_w, double dt, double fraction) {
+  return ExpQuat<double>(Vec3(rate_w * (dt * fraction)));
+}
+
+NavState Preintegration::Predict(const NavState& state_i, const ImuEarthTerms& earth) const {
+  if (earth.rate_w.isZero(0.0)) return Predict(state_i, earth.g_w);
+  const Delta d = Corrected(state_i.bg, state_i.ba);
+  const Mat3 R_wi = state_i.R_wb();
+  const double T = dt_total_;
+  const Vec3& w = earth.rate_w;
+  const Vec3& g = earth.g_w;
+  NavState state_j = state_i;
+  state_j.t = state_i.t + T;
+  state_j.q_wb = (ImuEarthTerms::Turn(w, T, 1.0).conjugate() * state_i.q_wb * d.dq).normalized();
+  // (I + [ω]×T)·(p_j − p_i) = v_i·T + ½g·T² + Exp(−ωT/3)·R_i·Δp
+  const Vec3 rhs = state_i.v_w * T + 0.5 * g * T * T + ImuEarthTerms::Turn(w, T, 1.0 / 3.0).conjugate() * (R_wi * d.dp);
+  const Vec3 dp_w = (Mat3::Identity() + Hat<double>(w) * T).inverse() * rhs;
+  state_j.p_wb = state_i.p_wb + dp_w;
+  state_j.v_w = state_i.v_w + g * T - 2.0 * w.cross(dp_w) + ImuEarthTerms::Turn(w, T, 0.5).conjugate() * (R_wi * d.dv);
+  return state_j;
+}
+
 NavState Preintegration::Predict(const NavState& state_i, const Vec3& g_w) const {
   const Delta d = Corrected(state_i.bg, state_i.ba);
   const Mat3 R_wi = state_i.R_wb();

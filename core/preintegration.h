@@ -32,6 +32,24 @@ constexpr int kBa = 3;
 
 using Mat96 = Eigen::Matrix<double, 9, 6>;
 
+// The Earth's part of what a preintegration predicts over its interval Δt (core/earth.h): gravity in w, held
+// over the interval, and the Earth rate ω_ie in w (zero: the flat model). The preintegrated deltas are body
+// increments against inertial space; w turns under them, and the Coriolis term integrates in closed form
+// because ∫v dt is the displacement:
+//   R_j = Exp(−ωΔt)·R_i·ΔR
+//   v_j = v_i + g·Δt − 2ω×(p_j − p_i) + Exp(−ωΔt/2)·R_i·Δv
+//   p_j = p_i + v_i·Δt + ½g·Δt² − ω×(p_j − p_i)·Δt + Exp(−ωΔt/3)·R_i·Δp
+// The half and third rotations are where w has turned on average under Δv and Δp (exact for a constant
+// specific force in w); the Coriolis terms take the path between i and j as straight. Both are first order
+// in ω·Δt (1e-4 over a second), far below the IMU noise.
+struct ImuEarthTerms {
+  Vec3 g_w = GravityWorld(kStandardGravity);
+  Vec3 rate_w = Vec3::Zero();
+
+  // The left rotations Exp(ω·Δt·k) for k = 1, 1/2, 1/3 (E1, E2, E3); the residuals use their transposes.
+  static Quat Turn(const Vec3& rate_w, double dt, double fraction);
+};
+
 class Preintegration {
  public:
   // A preintegrated (ΔR, Δv, Δp) triple, body frame of keyframe i.
@@ -68,6 +86,8 @@ class Preintegration {
   //   R_j = R_i·ΔR,  v_j = v_i + g·Δt + R_i·Δv,  p_j = p_i + v_i·Δt + ½g·Δt² + R_i·Δp;
   // biases are carried over, t_j = t_i + Δt.
   NavState Predict(const NavState& state_i, const Vec3& g_w) const;
+  // With the Earth's rotation (ImuEarthTerms).
+  NavState Predict(const NavState& state_i, const ImuEarthTerms& earth) const;
 
   double dt() const { return dt_total_; }
   const Delta& delta() const { return delta_; }

@@ -22,6 +22,17 @@ Mat9 SqrtInformation(const Mat9& cov) {
   return inv_sqrt.asDiagonal() * es.eigenvectors().transpose();
 }
 
+ImuFactor::ImuFactor(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth)
+    : ImuFactor(std::move(preint), earth.g_w) {
+  rotating_ = !earth.rate_w.isZero(0.0);
+  if (!rotating_) return;
+  rate_w_ = earth.rate_w;
+  const double dt = preint_->dt();
+  turn_p_ = ImuEarthTerms::Turn(rate_w_, dt, 1.0 / 3.0);
+  turn_v_ = ImuEarthTerms::Turn(rate_w_, dt, 0.5);
+  turn_r_ = ImuEarthTerms::Turn(rate_w_, dt, 1.0);
+}
+
 ImuFactor::ImuFactor(std::shared_ptr<const Preintegration> preint, const Vec3& g_w)
     : preint_(std::move(preint)), g_w_(g_w) {
   CHECK(preint_ != nullptr);
@@ -35,9 +46,19 @@ ceres::CostFunction* ImuFactor::Create(std::shared_ptr<const Preintegration> pre
   return new ImuCostFunction(std::move(preint), g_w);
 }
 
+ceres::CostFunction* ImuFactor::Create(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth) {
+  return new ImuCostFunction(std::move(preint), earth);
+}
+
 ceres::CostFunction* ImuFactor::CreateAutoDiff(std::shared_ptr<const Preintegration> preint, const Vec3& g_w) {
   return new ceres::AutoDiffCostFunction<ImuFactor, 9, pose::kAmbient, 3, 6, pose::kAmbient, 3>(
       new ImuFactor(std::move(preint), g_w));
+}
+
+ceres::CostFunction* ImuFactor::CreateAutoDiff(std::shared_ptr<const Preintegration> preint,
+                                               const ImuEarthTerms& earth) {
+  return new ceres::AutoDiffCostFunction<ImuFactor, 9, pose::kAmbient, 3, 6, pose::kAmbient, 3>(
+      new ImuFactor(std::move(preint), earth));
 }
 
 namespace {
@@ -80,14 +101,22 @@ bool ImuCostFunction::Evaluate(double const* const* parameters, double* residual
   const Eigen::Map<const Quat> q_i(pose_i + pose::kQ), q_j(pose_j + pose::kQ);
   const Mat3 R_iw = q_i.conjugate().toRotationMatrix();  // R_iᵀ
   const Vec3 r_theta = t.r.segment<3>(preint::kTheta);
-  const Mat93 S_p_R_iw = S_p * R_iw;
-  const Mat93 S_v_R_iw = S_v * R_iw;
   const Mat93 S_theta_Jr_inv = S_theta * RightJacobianInverse(r_theta);
+  // r_p and r_v see the world through R_iᵀ·E (E = I for the flat model), and with Earth rotation they also
+  // depend on D = p_j − p_i: ∂r_p/∂D = R_iᵀE_⅓(I + [ω]×Δt), ∂r_v/∂D = 2·R_iᵀE_½[ω]×.
+  const bool rotating = factor_.rotating();
+  const Mat93 S_p_R_iw = rotating ? Mat93(S_p * (R_iw * factor_.turn_p().toRotationMatrix())) : Mat93(S_p * R_iw);
+  const Mat93 S_v_R_iw = rotating ? Mat93(S_v * (R_iw * factor_.turn_v().toRotationMatrix())) : Mat93(S_v * R_iw);
+  Mat93 J_D = S_p_R_iw;
+  if (rotating) {
+    const Mat3 W = Hat<double>(factor_.rate_w());
+    J_D += S_p_R_iw * W * pi.dt() + 2.0 * S_v_R_iw * W;
+  }
 
   if (jacobians[0] != nullptr) {  // pose_i
     const Mat3 R_ji = t.q_ij.conjugate().toRotationMatrix();
     const Mat93 J_dtheta = S_p * Hat<double>(t.dp_i) + S_v * Hat<double>(t.dv_i) - S_theta_Jr_inv * R_ji;
-    WritePoseJacobian(-S_p_R_iw, J_dtheta, Quat(q_i), jacobians[0]);
+    WritePoseJacobian(-J_D, J_dtheta, Quat(q_i), jacobians[0]);
   }
   if (jacobians[1] != nullptr) {  // vel_i
     Eigen::Map<Eigen::Matrix<double, 9, 3, Eigen::RowMajor>> J(jacobians[1]);
@@ -103,7 +132,7 @@ bool ImuCostFunction::Evaluate(double const* const* parameters, double* residual
         S_theta_Jr_inv * (E_T * RightJacobian(t.phi_bg) * J_b.block<3, 3>(preint::kTheta, preint::kBg));
   }
   if (jacobians[3] != nullptr) {  // pose_j
-    WritePoseJacobian(S_p_R_iw, S_theta_Jr_inv, Quat(q_j), jacobians[3]);
+    WritePoseJacobian(J_D, S_theta_Jr_inv, Quat(q_j), jacobians[3]);
   }
   if (jacobians[4] != nullptr) {  // vel_j
     Eigen::Map<Eigen::Matrix<double, 9, 3, Eigen::RowMajor>> J(jacobians[4]);

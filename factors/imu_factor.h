@@ -7,6 +7,11 @@
 //   r_p = R_iᵀ(p_j − p_i − v_i·Δt − ½g·Δt²) − Δp_corr      (m)
 //   r_v = R_iᵀ(v_j − v_i − g·Δt) − Δv_corr                  (m/s)
 //   r_θ = Log(ΔR_corrᵀ·R_iᵀ·R_j)                              (rad)
+// With the Earth's rotation (ImuEarthTerms, core/preintegration.h; ω = ω_ie in w, D = p_j − p_i,
+// E_k = Exp(ω·Δt·k)):
+//   r_p = R_iᵀ·E_⅓·((I + [ω]×Δt)·D − v_i·Δt − ½g·Δt²) − Δp_corr
+//   r_v = R_iᵀ·E_½·(v_j − v_i − g·Δt + 2ω×D) − Δv_corr
+//   r_θ = Log(ΔR_corrᵀ·R_iᵀ·E_1·R_j)
 // where (ΔR, Δv, Δp)_corr are first-order corrected for δb = bias_i − (bg_lin, ba_lin) of the
 // preintegration. The residual is whitened: r_w = S·r with SᵀS = Σ⁻¹ (S = Lᵀ from the LLT of Σ⁻¹,
 // computed once at construction), so |r_w|² is the Mahalanobis distance.
@@ -55,6 +60,7 @@ class ImuFactor {
   static constexpr int kResidualDim = 9;
 
   ImuFactor(std::shared_ptr<const Preintegration> preint, const Vec3& g_w);
+  ImuFactor(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth);
 
   // The residual model, written once: the autodiff oracle (operator()) and the analytic cost function
   // (ImuCostFunction) both evaluate it through here.
@@ -78,9 +84,17 @@ class ImuFactor {
     const T dt = T(pi.dt());
     const Vec3T g = g_w_.cast<T>();
     const Eigen::Quaternion<T> q_iw = q_i.conjugate();
-    terms->dp_i = q_iw * Vec3T(p_j - p_i - v_i * dt - T(0.5) * g * dt * dt);
-    terms->dv_i = q_iw * Vec3T(v_j - v_i - g * dt);
-    terms->q_ij = q_iw * q_j;
+    if (rotating_) {
+      const Vec3T w = rate_w_.cast<T>();
+      const Vec3T D = p_j - p_i;
+      terms->dp_i = (q_iw * turn_p_.cast<T>()) * Vec3T(D + w.cross(D) * dt - v_i * dt - T(0.5) * g * dt * dt);
+      terms->dv_i = (q_iw * turn_v_.cast<T>()) * Vec3T(v_j - v_i - g * dt + T(2) * w.cross(D));
+      terms->q_ij = q_iw * turn_r_.cast<T>() * q_j;
+    } else {
+      terms->dp_i = q_iw * Vec3T(p_j - p_i - v_i * dt - T(0.5) * g * dt * dt);
+      terms->dv_i = q_iw * Vec3T(v_j - v_i - g * dt);
+      terms->q_ij = q_iw * q_j;
+    }
     terms->q_err = dq_corr.conjugate() * terms->q_ij;
     terms->r.template segment<3>(preint::kP) = terms->dp_i - dp_corr;
     terms->r.template segment<3>(preint::kV) = terms->dv_i - dv_corr;
@@ -100,16 +114,28 @@ class ImuFactor {
   // The production cost function: ImuCostFunction (analytic Jacobians); caller owns it (or hands it to a
   // Problem).
   static ceres::CostFunction* Create(std::shared_ptr<const Preintegration> preint, const Vec3& g_w);
+  static ceres::CostFunction* Create(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth);
   // AutoDiffCostFunction<ImuFactor, 9, 7, 3, 6, 7, 3> of the same residual: the test oracle of Create's
   // Jacobians (about 20× slower with Jacobians).
   static ceres::CostFunction* CreateAutoDiff(std::shared_ptr<const Preintegration> preint, const Vec3& g_w);
+  static ceres::CostFunction* CreateAutoDiff(std::shared_ptr<const Preintegration> preint,
+                                             const ImuEarthTerms& earth);
 
   const Mat9& sqrt_information() const { return sqrt_info_; }
   const Preintegration& preintegration() const { return *preint_; }
+  bool rotating() const { return rotating_; }
+  const Vec3& rate_w() const { return rate_w_; }
+  // E_⅓, E_½, E_1 of the residual (identity for the flat model).
+  const Quat& turn_p() const { return turn_p_; }
+  const Quat& turn_v() const { return turn_v_; }
+  const Quat& turn_r() const { return turn_r_; }
 
  private:
   std::shared_ptr<const Preintegration> preint_;
   Vec3 g_w_;
+  bool rotating_ = false;
+  Vec3 rate_w_ = Vec3::Zero();
+  Quat turn_p_ = Quat::Identity(), turn_v_ = Quat::Identity(), turn_r_ = Quat::Identity();
   Mat9 sqrt_info_;
 };
 
@@ -138,6 +164,8 @@ class ImuCostFunction final : public ceres::SizedCostFunction<9, pose::kAmbient,
  public:
   ImuCostFunction(std::shared_ptr<const Preintegration> preint, const Vec3& g_w)
       : factor_(std::move(preint), g_w) {}
+  ImuCostFunction(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth)
+      : factor_(std::move(preint), earth) {}
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
 

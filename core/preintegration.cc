@@ -84,21 +84,24 @@ Quat ImuEarthTerms::Turn(const Vec3& rate_w, double dt, double fraction) {
   return ExpQuat<double>(Vec3(rate_w * (dt * fraction)));
 }
 
+EarthTurns::EarthTurns(const ImuEarthTerms& earth, double dt) : rotating(!earth.rate_w.isZero(0.0)) {
+  if (!rotating) return;
+  back_r = ImuEarthTerms::Turn(earth.rate_w, dt, 1.0).conjugate();
+  back_v = ImuEarthTerms::Turn(earth.rate_w, dt, 0.5).conjugate();
+  back_p = ImuEarthTerms::Turn(earth.rate_w, dt, 1.0 / 3.0).conjugate();
+  m_inv = (Mat3::Identity() + Hat<double>(earth.rate_w) * dt).inverse();
+}
+
 NavState Preintegration::Predict(const NavState& state_i, const ImuEarthTerms& earth) const {
   if (earth.rate_w.isZero(0.0)) return Predict(state_i, earth.g_w);
-  const Delta d = Corrected(state_i.bg, state_i.ba);
-  const Mat3 R_wi = state_i.R_wb();
-  const double T = dt_total_;
-  const Vec3& w = earth.rate_w;
-  const Vec3& g = earth.g_w;
+  const PredictedKinematics<double> k =
+      PredictKinematics<double>(*this, earth, EarthTurns(earth, dt_total_), state_i.p_wb, state_i.q_wb,
+                                state_i.v_w, state_i.bg, state_i.ba);
   NavState state_j = state_i;
-  state_j.t = state_i.t + T;
-  state_j.q_wb = (ImuEarthTerms::Turn(w, T, 1.0).conjugate() * state_i.q_wb * d.dq).normalized();
-  // (I + [ω]×T)·(p_j − p_i) = v_i·T + ½g·T² + Exp(−ωT/3)·R_i·Δp
-  const Vec3 rhs = state_i.v_w * T + 0.5 * g * T * T + ImuEarthTerms::Turn(w, T, 1.0 / 3.0).conjugate() * (R_wi * d.dp);
-  const Vec3 dp_w = (Mat3::Identity() + Hat<double>(w) * T).inverse() * rhs;
-  state_j.p_wb = state_i.p_wb + dp_w;
-  state_j.v_w = state_i.v_w + g * T - 2.0 * w.cross(dp_w) + ImuEarthTerms::Turn(w, T, 0.5).conjugate() * (R_wi * d.dv);
+  state_j.t = state_i.t + dt_total_;
+  state_j.q_wb = k.q.normalized();
+  state_j.v_w = k.v;
+  state_j.p_wb = k.p;
   return state_j;
 }
 
@@ -112,6 +115,33 @@ NavState Preintegration::Predict(const NavState& state_i, const Vec3& g_w) const
   state_j.v_w = state_i.v_w + g_w * T + R_wi * d.dv;
   state_j.p_wb = state_i.p_wb + state_i.v_w * T + 0.5 * g_w * T * T + R_wi * d.dp;
   return state_j;
+}
+
+Mat15 PredictedCovariance(const NavState& x_i, const Mat15& P_i, const Preintegration& pre, double gyro_bias_rw,
+                          double acc_bias_rw) {
+  const Preintegration::Delta d = pre.Corrected(x_i.bg, x_i.ba);
+  const Mat3 R_i = x_i.R_wb();
+  const double T = pre.dt();
+  const Mat96& J = pre.bias_jacobian();
+  Mat15 Phi = Mat15::Identity();
+  Phi.block<3, 3>(nav::kP, nav::kV) = Mat3::Identity() * T;
+  Phi.block<3, 3>(nav::kP, nav::kTheta) = -R_i * Hat<double>(d.dp);
+  Phi.block<3, 3>(nav::kV, nav::kTheta) = -R_i * Hat<double>(d.dv);
+  Phi.block<3, 3>(nav::kTheta, nav::kTheta) = d.dq.toRotationMatrix().transpose();
+  Phi.block<3, 6>(nav::kP, nav::kBg) = R_i * J.middleRows<3>(preint::kP);
+  Phi.block<3, 6>(nav::kV, nav::kBg) = R_i * J.middleRows<3>(preint::kV);
+  Phi.block<3, 3>(nav::kTheta, nav::kBg) = J.block<3, 3>(preint::kTheta, preint::kBg);
+  // The deltas' noise: δp and δv rotate into w, δθ is already the right perturbation of R_j.
+  Mat9 Rot = Mat9::Identity();
+  Rot.block<3, 3>(preint::kP, preint::kP) = R_i;
+  Rot.block<3, 3>(preint::kV, preint::kV) = R_i;
+  const Mat9 Q9 = Rot * pre.cov() * Rot.transpose();
+  Mat15 P = Phi * P_i * Phi.transpose();
+  // Preintegration order (δp, δv, δθ) is NavState's first nine.
+  P.topLeftCorner<9, 9>() += Q9;
+  P.block<3, 3>(nav::kBg, nav::kBg).diagonal().array() += gyro_bias_rw * gyro_bias_rw * T;
+  P.block<3, 3>(nav::kBa, nav::kBa).diagonal().array() += acc_bias_rw * acc_bias_rw * T;
+  return 0.5 * (P + P.transpose());
 }
 
 }  // namespace gins

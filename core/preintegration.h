@@ -18,6 +18,7 @@
 #include "core/conventions.h"
 #include "core/measurements.h"
 #include "core/nav_state.h"
+#include "core/so3.h"
 
 namespace gins {
 
@@ -31,6 +32,12 @@ constexpr int kBa = 3;
 }  // namespace preint
 
 using Mat96 = Eigen::Matrix<double, 9, 6>;
+
+template <typename T>
+struct PredictedKinematics {
+  Eigen::Matrix<T, 3, 1> p, v;
+  Eigen::Quaternion<T> q;
+};
 
 // The Earth's part of what a preintegration predicts over its interval Δt (core/earth.h): gravity in w, held
 // over the interval, and the Earth rate ω_ie in w (zero: the flat model). The preintegrated deltas are body
@@ -48,6 +55,17 @@ struct ImuEarthTerms {
 
   // The left rotations Exp(ω·Δt·k) for k = 1, 1/2, 1/3 (E1, E2, E3); the residuals use their transposes.
   static Quat Turn(const Vec3& rate_w, double dt, double fraction);
+};
+
+// The constants of one prediction over Δt: the turns of w and (I + [ω]×Δt)⁻¹ of the position equation.
+struct EarthTurns {
+  bool rotating = false;
+  Quat back_r = Quat::Identity();  // Exp(−ωΔt)
+  Quat back_v = Quat::Identity();  // Exp(−ωΔt/2)
+  Quat back_p = Quat::Identity();  // Exp(−ωΔt/3)
+  Mat3 m_inv = Mat3::Identity();   // (I + [ω]×Δt)⁻¹
+  EarthTurns() = default;
+  EarthTurns(const ImuEarthTerms& earth, double dt);
 };
 
 class Preintegration {
@@ -129,5 +147,44 @@ class Preintegration {
   Mat9 cov_ = Mat9::Zero();
   Mat96 J_bias_ = Mat96::Zero();
 };
+
+// Covariance of Predict's state j (NavState tangent order δp, δv, δθ, δbg, δba) given state i's covariance P_i:
+// the error propagated through the bias-corrected deltas (Φ), plus the preintegration's noise rotated into w
+// and the bias random walks over Δt (gyro_bias_rw rad/s/√s, acc_bias_rw m/s²/√s, as ImuOptions). The random
+// walks enter the biases only, not the kinematics within the interval (second order over a keyframe
+// interval), and Earth rotation changes Φ by ~ω·Δt (1e-4): both are left out.
+Mat15 PredictedCovariance(const NavState& x_i, const Mat15& P_i, const Preintegration& pre, double gyro_bias_rw,
+                          double acc_bias_rw);
+
+// Preintegration::Predict written once for any scalar type (the factors that attach a measurement at a time
+// between keyframes differentiate it with Ceres's Jets): pose and velocity at j from state i and its biases,
+// first-order bias-corrected, with the Earth terms of ImuEarthTerms.
+template <typename T>
+PredictedKinematics<T> PredictKinematics(const Preintegration& pre, const ImuEarthTerms& earth,
+                                         const EarthTurns& turns, const Eigen::Matrix<T, 3, 1>& p_i,
+                                         const Eigen::Quaternion<T>& q_i, const Eigen::Matrix<T, 3, 1>& v_i,
+                                         const Eigen::Matrix<T, 3, 1>& bg, const Eigen::Matrix<T, 3, 1>& ba) {
+  using Vec3T = Eigen::Matrix<T, 3, 1>;
+  const Vec3T dbg = bg - pre.bg_lin().cast<T>();
+  const Vec3T dba = ba - pre.ba_lin().cast<T>();
+  const Eigen::Quaternion<T> dq = pre.dq().cast<T>() * ExpQuat<T>(Vec3T(pre.dR_dbg().cast<T>() * dbg));
+  const Vec3T dv = pre.dv().cast<T>() + pre.dv_dbg().cast<T>() * dbg + pre.dv_dba().cast<T>() * dba;
+  const Vec3T dp = pre.dp().cast<T>() + pre.dp_dbg().cast<T>() * dbg + pre.dp_dba().cast<T>() * dba;
+  const T dt = T(pre.dt());
+  const Vec3T g = earth.g_w.cast<T>();
+  PredictedKinematics<T> out;
+  if (!turns.rotating) {
+    out.q = q_i * dq;
+    out.v = v_i + g * dt + q_i * dv;
+    out.p = p_i + v_i * dt + T(0.5) * g * dt * dt + q_i * dp;
+    return out;
+  }
+  out.q = turns.back_r.cast<T>() * q_i * dq;
+  const Vec3T rhs = v_i * dt + T(0.5) * g * dt * dt + turns.back_p.cast<T>() * (q_i * dp);
+  const Vec3T d_p = turns.m_inv.cast<T>() * rhs;
+  out.p = p_i + d_p;
+  out.v = v_i + g * dt - T(2) * earth.rate_w.cast<T>().cross(d_p) + turns.back_v.cast<T>() * (q_i * dv);
+  return out;
+}
 
 }  // namespace gins

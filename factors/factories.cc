@@ -4,7 +4,12 @@
 #include <glog/logging.h>
 
 #include "factors/bias_rw_factor.h"
+#include "factors/chord_factor.h"
 #include "factors/gnss_factor.h"
+#include "factors/gnss_preint_factor.h"
+#include "factors/gvel_factor.h"
+#include "factors/odometer_factor.h"
+#include "factors/wheel_yaw_factor.h"
 #include "factors/heading_factor.h"
 #include "factors/nhc_factor.h"
 #include "factors/scale_rw_factor.h"
@@ -31,9 +36,43 @@ ceres::CostFunction* WheelFactor::Create(double speed_meas, double sigma) {
       new WheelFactor(speed_meas, sigma));
 }
 
-ceres::CostFunction* NhcFactor::Create(double sigma) {
+ceres::CostFunction* NhcFactor::Create(double sigma, const Vec3& omega_b, const Vec3& lever_b) {
   CHECK_GT(sigma, 0.0) << "NhcFactor: σ must be > 0";
-  return new ceres::AutoDiffCostFunction<NhcFactor, 2, pose::kAmbient, 3>(new NhcFactor(sigma));
+  return new ceres::AutoDiffCostFunction<NhcFactor, 2, pose::kAmbient, 3>(new NhcFactor(sigma, omega_b, lever_b));
+}
+
+ceres::CostFunction* GnssPreintFactor::Create(std::shared_ptr<const Preintegration> preint,
+                                              const ImuEarthTerms& earth, const Vec3& z_w, const Vec3& sigma_w,
+                                              const Vec3& lever_b) {
+  CHECK((sigma_w.array() > 0.0).all()) << "GnssPreintFactor: σ must be > 0, got " << sigma_w.transpose();
+  CHECK(preint != nullptr);
+  return new ceres::AutoDiffCostFunction<GnssPreintFactor, 3, pose::kAmbient, 3, 6>(
+      new GnssPreintFactor(std::move(preint), earth, z_w, sigma_w, lever_b));
+}
+
+ceres::CostFunction* GvelFactor::Create(const Vec3& z_w, const Vec3& sigma_w, const Vec3& omega_b,
+                                        const Vec3& lever_b) {
+  CHECK((sigma_w.array() > 0.0).all()) << "GvelFactor: σ must be > 0, got " << sigma_w.transpose();
+  return new ceres::AutoDiffCostFunction<GvelFactor, 3, pose::kAmbient, 3>(
+      new GvelFactor(z_w, sigma_w, omega_b, lever_b));
+}
+
+ceres::CostFunction* OdometerFactor::Create(const Vec3& displacement_i, double sigma, const Vec3& lever_b) {
+  CHECK_GT(sigma, 0.0) << "OdometerFactor: σ must be > 0";
+  return new ceres::AutoDiffCostFunction<OdometerFactor, 1, pose::kAmbient, pose::kAmbient, 1>(
+      new OdometerFactor(displacement_i, sigma, lever_b));
+}
+
+ceres::CostFunction* ChordFactor::Create(double dt, double sigma, const Vec3& lever_b) {
+  CHECK(dt > 0.0 && sigma > 0.0) << "ChordFactor: dt and σ must be > 0";
+  return new ceres::AutoDiffCostFunction<ChordFactor, 2, pose::kAmbient, pose::kAmbient>(
+      new ChordFactor(dt, sigma, lever_b));
+}
+
+ceres::CostFunction* WheelYawFactor::Create(double yaw_change, double sigma) {
+  CHECK_GT(sigma, 0.0) << "WheelYawFactor: σ must be > 0";
+  return new ceres::AutoDiffCostFunction<WheelYawFactor, 1, pose::kAmbient, pose::kAmbient, 1>(
+      new WheelYawFactor(yaw_change, sigma));
 }
 
 ceres::CostFunction* BiasRwFactor::Create(double gyro_bias_rw, double acc_bias_rw, double dt) {

@@ -230,3 +230,57 @@ TEST(PreintegrationTest, ReintegrateAtSameBiasIsIdentityAndZeroDtIsIgnored) {
 
 }  // namespace
 }  // namespace gins
+
+namespace gins {
+namespace {
+
+// PredictedCovariance equals the filter's step-by-step propagation of the same error state through the
+// kernel's Jacobians (F = [[A, B], [0, I]], the same discrete white noise): both are the linearised model of
+// the same steps, so without bias random walk they agree to rounding.
+TEST(PredictedCovarianceTest, EqualsStepwisePropagation) {
+  const double dt = 0.01, gyro_nd = 2e-3, acc_nd = 2e-2;
+  NavState x_i;
+  x_i.p_wb = Vec3(1.0, 2.0, 3.0);
+  x_i.v_w = Vec3(8.0, -3.0, 0.5);
+  x_i.q_wb = ExpQuat<double>(Vec3(0.2, -0.1, 1.1));
+  x_i.bg = Vec3(0.01, -0.005, 0.02);
+  x_i.ba = Vec3(0.05, 0.02, -0.04);
+  Mat15 P_i = Mat15::Zero();
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n01;
+  for (int r = 0; r < 15; ++r) {
+    for (int c = 0; c < 15; ++c) P_i(r, c) = 0.01 * n01(rng);
+  }
+  P_i = P_i * P_i.transpose() + 1e-4 * Mat15::Identity();
+
+  Preintegration pre(x_i.bg, x_i.ba, gyro_nd, acc_nd);
+  Kinematics k{x_i.q_wb, x_i.v_w, x_i.p_wb};
+  Mat15 P = P_i;
+  const Vec3 g = GravityWorld(9.81);
+  for (int s = 0; s < 80; ++s) {
+    const double t = s * dt;
+    const Vec3 gyro = x_i.bg + Vec3(0.3 * std::sin(2.0 * t), -0.2, 0.5 * std::cos(t));
+    const Vec3 acc = x_i.ba + Vec3(1.0 + 0.5 * std::cos(1.3 * t), 0.4 * std::sin(2.1 * t), 9.81);
+    pre.Integrate(gyro, acc, dt);
+    ImuStepJacobians J;
+    k = ImuStep(k, gyro - x_i.bg, acc - x_i.ba, g, dt, &J);
+    Mat15 F = Mat15::Identity();
+    F.topLeftCorner<9, 9>() = J.A;
+    F.block<9, 6>(0, 9) = J.B;
+    Mat15 Gq = Mat15::Zero();
+    Gq.topLeftCorner<9, 9>() = J.B * ImuDiscreteNoise(gyro_nd, acc_nd, dt) * J.B.transpose();
+    P = F * P * F.transpose() + Gq;
+  }
+  const Mat15 P_pred = PredictedCovariance(x_i, P_i, pre, 0.0, 0.0);
+  EXPECT_LT((P_pred - P).cwiseAbs().maxCoeff(), 1e-12 * P.cwiseAbs().maxCoeff());
+  // The bias random walks add σ²·Δt to the bias block.
+  const Mat15 P_rw = PredictedCovariance(x_i, P_i, pre, 1e-4, 1e-3);
+  EXPECT_NEAR(P_rw(9, 9) - P_pred(9, 9), 1e-8 * 0.8, 1e-15);
+  EXPECT_NEAR(P_rw(14, 14) - P_pred(14, 14), 1e-6 * 0.8, 1e-13);
+  // And the predicted mean is the kernel's.
+  const NavState x_j = pre.Predict(x_i, g);
+  EXPECT_LT((x_j.p_wb - k.p).norm(), 1e-9);
+}
+
+}  // namespace
+}  // namespace gins

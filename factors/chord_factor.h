@@ -1,0 +1,45 @@
+// Chord factor: the non-holonomic constraint between keyframes i and j (core/odometry_model.h): the rear-axle
+// centre's chord points along the body x axis halfway between the two attitudes.
+//
+// Parameter blocks: pose_i (7), pose_j (7) (factors/pose_manifold.h).
+// Residual (2):
+//   r = ((R_mᵀ·(a_j − a_i)).y, (R_mᵀ·(a_j − a_i)).z) / (Δt·σ)   (unitless; σ in m/s, the mean lateral and
+//                                                                vertical speed's 1-σ over the interval)
+// The raw residual is ChordModel::Residual.
+#pragma once
+
+#include <ceres/cost_function.h>
+
+#include "core/conventions.h"
+#include "core/odometry_model.h"
+#include "factors/pose_manifold.h"
+
+namespace gins {
+
+class ChordFactor {
+ public:
+  static constexpr int kResidualDim = ChordModel::kResidualDim;
+
+  // dt: t_j − t_i (s, > 0); sigma (m/s, > 0); lever_b: rear-axle centre in b.
+  ChordFactor(double dt, double sigma, const Vec3& lever_b) : dt_(dt), inv_sigma_(1.0 / sigma), lever_b_(lever_b) {}
+
+  template <typename T>
+  bool operator()(const T* pose_i, const T* pose_j, T* residual) const {
+    Eigen::Map<Eigen::Matrix<T, 2, 1>> out(residual);
+    out = ChordModel::Residual<T>(Eigen::Matrix<T, 3, 1>(PosePosition(pose_i)),
+                                  Eigen::Quaternion<T>(PoseRotation(pose_i)),
+                                  Eigen::Matrix<T, 3, 1>(PosePosition(pose_j)),
+                                  Eigen::Quaternion<T>(PoseRotation(pose_j)), lever_b_, dt_) *
+          T(inv_sigma_);
+    return true;
+  }
+
+  // AutoDiffCostFunction<ChordFactor, 2, 7, 7>.
+  static ceres::CostFunction* Create(double dt, double sigma, const Vec3& lever_b);
+
+ private:
+  double dt_, inv_sigma_;
+  Vec3 lever_b_;
+};
+
+}  // namespace gins

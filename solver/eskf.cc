@@ -13,6 +13,10 @@
 #include "core/wheel_model.h"
 
 namespace gins {
+
+using eskf::Block;
+using eskf::BlockOf;
+
 namespace {
 
 double GateFor(double probability, int dof) {
@@ -24,8 +28,6 @@ constexpr double kGapAccSigma = 2.0;                // m/s²
 constexpr double kGapRateSigma = 10.0 * kDegToRad;  // rad/s
 constexpr size_t kMaxListed = 100;                  // gaps and resets listed in the summary
 constexpr double kZeroRateGateProbability = 0.9999;  // the gyro-reads-its-bias update at standstills
-// Watchdog re-initialisation: position 1-σ added to the fix's, velocity 1-σ, and the longest fix interval
-// a velocity is differenced over.
 
 }  // namespace
 
@@ -46,7 +48,7 @@ void Eskf::Initialize(const InitResult& init) {
   P_.setZero();
   P_.topLeftCorner<nav::kDim, nav::kDim>() = init.P0;
   if (options_.eskf.estimate_gravity) {
-    P_.block<3, 3>(eskf::kG, eskf::kG).diagonal().setConstant(options_.eskf.gravity_sigma * options_.eskf.gravity_sigma);
+    BlockOf<Block::kG>(P_).diagonal().setConstant(options_.eskf.gravity_sigma * options_.eskf.gravity_sigma);
   }
   if (options_.wheel.enabled && options_.wheel.estimate_scale) {
     P_(eskf::kS, eskf::kS) = options_.wheel.scale_sigma * options_.wheel.scale_sigma;
@@ -77,22 +79,28 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   x_.p_wb = k.p;
   x_.t = t;
   ++imu_steps_;
+  PropagateCovariance(J, dt, gap);
+}
 
+void Eskf::PropagateCovariance(const ImuStepJacobians& J, double dt, bool gap) {
   // F = [[A, C], [0, I]] with the kinematic block a = (δp, δv, δθ) and b = (δbg, δba, δg, δs), C = [B G 0]:
   // P'aa = A·Paa·Aᵀ + A·Pab·Cᵀ + C·Pba·Aᵀ + C·Pbb·Cᵀ = (A·M1ᵀ + C·Mᵀ)ᵀ with M1 = A·Paa + C·Pba and
-  // M = P'ab = A·Pab + C·Pbb. The products skip A's and C's zero and identity blocks (MulA, MulBG).
-  using Mat9x10 = Eigen::Matrix<double, 9, 10>;
+  // M = P'ab = A·Pab + C·Pbb. The products skip A's and C's zero and identity blocks (MulA, MulBG). C has
+  // columns for the driving blocks (δbg, δba, δg) only, so Pba and Pbb enter through their driving rows.
+  constexpr int kA = eskf::kKinematicDim, kB = eskf::kNonKinematicDim, kD = eskf::kDrivingDim;
+  using MatAA = Eigen::Matrix<double, kA, kA>;
+  using MatAB = Eigen::Matrix<double, kA, kB>;
   const bool with_g = options_.eskf.estimate_gravity;
-  const Mat9 Paa = P_.topLeftCorner<9, 9>();
-  const Mat9x10 Pab = P_.topRightCorner<9, 10>();
-  const Mat9 Pba9 = P_.block<9, 9>(9, 0);  // rows δbg, δba, δg of Pba (C has no δs column)
-  const Mat9x10 Pbb9 = P_.block<9, 10>(9, 9);
-  const Mat9x10 M = MulA<10>(J, Pab) + MulBG<10>(J, Pbb9, with_g);
-  const Mat9 M1 = MulA<9>(J, Paa) + MulBG<9>(J, Pba9, with_g);
-  const Mat9 MtC = M.leftCols<9>().transpose();  // rows δbg, δba, δg of Mᵀ
-  P_.topLeftCorner<9, 9>() = (MulA<9>(J, Mat9(M1.transpose())) + MulBG<9>(J, MtC, with_g)).transpose();
-  P_.topRightCorner<9, 10>() = M;
-  P_.bottomLeftCorner<10, 9>() = M.transpose();
+  const MatAA Paa = P_.topLeftCorner<kA, kA>();
+  const MatAB Pab = P_.topRightCorner<kA, kB>();
+  const Eigen::Matrix<double, kD, kA> PbaD = P_.block<kD, kA>(kA, 0);
+  const Eigen::Matrix<double, kD, kB> PbbD = P_.block<kD, kB>(kA, kA);
+  const MatAB M = MulA<kB>(J, Pab) + MulBG<kB>(J, PbbD, with_g);
+  const MatAA M1 = MulA<kA>(J, Paa) + MulBG<kA>(J, PbaD, with_g);
+  const Eigen::Matrix<double, kD, kA> MtC = M.leftCols<kD>().transpose();  // driving rows of Mᵀ
+  P_.topLeftCorner<kA, kA>() = (MulA<kA>(J, MatAA(M1.transpose())) + MulBG<kA>(J, MtC, with_g)).transpose();
+  P_.topRightCorner<kA, kB>() = M;
+  P_.bottomLeftCorner<kB, kA>() = M.transpose();
 
   // Process noise: sensor white noise through B, bias and scale random walks.
   Mat6 Qn = ImuDiscreteNoise(options_.imu.gyro_noise_density, options_.imu.acc_noise_density, dt);
@@ -102,12 +110,16 @@ void Eskf::Propagate(double t, const ImuSample* held) {
                       Vec3::Constant(kGapAccSigma * kGapAccSigma))
                          .finished();
   }
-  const Eigen::Matrix<double, 9, 6> BQ = J.B.lazyProduct(Qn);
-  P_.topLeftCorner<9, 9>() += BQ.lazyProduct(J.B.transpose());
+  const Eigen::Matrix<double, kA, 6> BQ = J.B.lazyProduct(Qn);
+  P_.topLeftCorner<kA, kA>() += BQ.lazyProduct(J.B.transpose());
+  AddRandomWalks(dt);
+}
+
+void Eskf::AddRandomWalks(double dt) {
   const double qbg = options_.imu.gyro_bias_rw * options_.imu.gyro_bias_rw * dt;
   const double qba = options_.imu.acc_bias_rw * options_.imu.acc_bias_rw * dt;
-  P_.block<3, 3>(nav::kBg, nav::kBg).diagonal().array() += qbg;
-  P_.block<3, 3>(nav::kBa, nav::kBa).diagonal().array() += qba;
+  BlockOf<Block::kBg>(P_).diagonal().array() += qbg;
+  BlockOf<Block::kBa>(P_).diagonal().array() += qba;
   if (options_.wheel.enabled && options_.wheel.estimate_scale) {
     P_(eskf::kS, eskf::kS) += options_.wheel.scale_rw * options_.wheel.scale_rw * dt;
   }
@@ -131,44 +143,28 @@ void Eskf::AddImu(const ImuSample& imu) {
 }
 
 template <int M>
-bool Eskf::Update(const Eigen::Matrix<double, M, 1>& r, const Eigen::Matrix<double, M, eskf::kDim>& H,
+bool Eskf::Update(const Eigen::Matrix<double, M, 1>& r, std::initializer_list<eskf::BlockJacobian<M>> H,
                   const Eigen::Matrix<double, M, M>& R, double gate, MeasurementCounts* counts, double t) {
-  const Eigen::Matrix<double, eskf::kDim, M> PHt = P_.lazyProduct(H.transpose());
-  const Eigen::Matrix<double, M, M> S = H.lazyProduct(PHt) + R;
-  const Eigen::LLT<Eigen::Matrix<double, M, M>> llt(S);
-  if (llt.info() != Eigen::Success || !r.allFinite()) {
-    counts->Reject("numerical", t);
+  VecP dx;
+  if (!eskf::GatedUpdate<M, eskf::kDim>(r, eskf::EmbedJacobian<M>(H), R, gate, t, counts, &P_, &dx)) {
     return false;
   }
-  const double chi2 = r.dot(llt.solve(r));
-  if (!(chi2 <= gate)) {
-    counts->Reject("chi2_gate", t);
-    return false;
-  }
-  const Eigen::Matrix<double, eskf::kDim, M> K = llt.solve(PHt.transpose()).transpose();
-  const VecP dx = -K * r;
-  // Joseph form, (I−KH)P(I−KH)ᵀ + KRKᵀ, which keeps P symmetric and positive for any gain, expanded as
-  // P − K(PHᵀ)ᵀ − PHᵀKᵀ + KSKᵀ: rank-M products instead of three 19×19 ones.
-  const Eigen::Matrix<double, eskf::kDim, M> KS = K.lazyProduct(S);
-  const MatP KHP = K.lazyProduct(PHt.transpose());
-  P_ += KS.lazyProduct(K.transpose()) - KHP - KHP.transpose();
   Inject(dx);
-  ++counts->used;
   return true;
 }
 
 void Eskf::Inject(const VecP& dx) {
   x_ = x_.Boxplus(dx.head<nav::kDim>());
-  g_w_ += dx.segment<3>(eskf::kG);
+  g_w_ += eskf::SegmentOf<Block::kG>(dx);
   scale_ += dx[eskf::kS];
   // Reset: the error is now zero about the corrected rotation; project the covariance accordingly
   // (right perturbation: ∂δθ⁺/∂δθ = I − ½[δθ]×).
   // Jr is the identity but for its δθ block, so only the δθ rows and columns of P change.
-  const Mat3 Jt = Mat3::Identity() - 0.5 * Hat<double>(Vec3(dx.segment<3>(nav::kTheta)));
-  const Eigen::Matrix<double, 3, eskf::kDim> rows = Jt.lazyProduct(P_.middleRows<3>(nav::kTheta));
-  P_.middleRows<3>(nav::kTheta) = rows;
-  const Eigen::Matrix<double, eskf::kDim, 3> cols = P_.middleCols<3>(nav::kTheta).lazyProduct(Jt.transpose());
-  P_.middleCols<3>(nav::kTheta) = cols;
+  const Mat3 Jt = Mat3::Identity() - 0.5 * Hat<double>(Vec3(eskf::SegmentOf<Block::kTheta>(dx)));
+  const Eigen::Matrix<double, 3, eskf::kDim> rows = Jt.lazyProduct(eskf::RowsOf<Block::kTheta>(P_));
+  eskf::RowsOf<Block::kTheta>(P_) = rows;
+  const Eigen::Matrix<double, eskf::kDim, 3> cols = eskf::ColsOf<Block::kTheta>(P_).lazyProduct(Jt.transpose());
+  eskf::ColsOf<Block::kTheta>(P_) = cols;
   P_ = 0.5 * (P_ + P_.transpose()).eval();
 }
 
@@ -178,7 +174,7 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
   if (options_.watchdog.enabled) {
     const double max_sigma = options_.watchdog.max_position_sigma;
     const bool finite = x_.AllFinite() && P_.allFinite() && g_w_.allFinite() && std::isfinite(scale_);
-    if (!finite || P_.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff() > max_sigma * max_sigma) {
+    if (!finite || BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
       ResetFromGnss(m, finite ? "covariance" : "non_finite");
       prev_fix_ = m;
       return;
@@ -197,11 +193,9 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
           return GnssPositionModel::Residual<T>(p, q, options_.gnss.lever_b, m.p_w);
         },
         &r, &H6);
-    Eigen::Matrix<double, 3, eskf::kDim> H = Eigen::Matrix<double, 3, eskf::kDim>::Zero();
-    H.block<3, 3>(0, nav::kP) = H6.leftCols<3>();
-    H.block<3, 3>(0, nav::kTheta) = H6.rightCols<3>();
     const Mat3 R = m.sigma_w.cwiseAbs2().asDiagonal();
-    accepted = Update<3>(r, H, R, gate_gnss_, &gnss_counts_, m.t);
+    accepted = Update<3>(r, {{Block::kP, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}}, R, gate_gnss_,
+                         &gnss_counts_, m.t);
   }
   const bool reset = WatchGnss(m, accepted);
   prev_fix_ = m;
@@ -217,11 +211,9 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
           return Eigen::Matrix<T, 1, 1>(HeadingModel::Residual<T>(q, options_.gnss.mount_yaw, m.yaw_G));
         },
         &r, &H3);
-    Eigen::Matrix<double, 1, eskf::kDim> H = Eigen::Matrix<double, 1, eskf::kDim>::Zero();
-    H.block<1, 3>(0, nav::kTheta) = H3;
     Eigen::Matrix<double, 1, 1> R;
     R(0, 0) = m.sigma_yaw * m.sigma_yaw;
-    Update<1>(r, H, R, gate_heading_, &heading_counts_, m.t);
+    Update<1>(r, {{Block::kTheta, H3}}, R, gate_heading_, &heading_counts_, m.t);
   }
 }
 
@@ -247,13 +239,13 @@ void Eskf::AddWheel(const WheelMeasurement& m) {
           return Eigen::Matrix<T, 1, 1>(WheelSpeedModel::Residual<T>(q, v, s, m.speed));
         },
         &r, &H7);
-    Eigen::Matrix<double, 1, eskf::kDim> H = Eigen::Matrix<double, 1, eskf::kDim>::Zero();
-    H.block<1, 3>(0, nav::kV) = H7.leftCols<3>();
-    H.block<1, 3>(0, nav::kTheta) = H7.block<1, 3>(0, 3);
-    if (options_.wheel.estimate_scale) H(0, eskf::kS) = H7(0, 6);
+    if (!options_.wheel.estimate_scale) H7(0, 6) = 0.0;  // a scale held fixed takes no correction
     Eigen::Matrix<double, 1, 1> R;
     R(0, 0) = m.sigma * m.sigma;
-    Update<1>(r, H, R, gate_wheel_, &wheel_counts_, m.t);
+    Update<1>(r,
+              {{Block::kV, H7.leftCols<3>()}, {Block::kTheta, H7.middleCols<3>(3)},
+               {Block::kS, H7.rightCols<1>()}},
+              R, gate_wheel_, &wheel_counts_, m.t);
     if (options_.wheel.nonholonomic) {
       Eigen::Matrix<double, 2, 1> rn;
       Eigen::Matrix<double, 2, 6> H6;
@@ -265,12 +257,9 @@ void Eskf::AddWheel(const WheelMeasurement& m) {
             return NonHolonomicModel::Residual<T>(q, v);
           },
           &rn, &H6);
-      Eigen::Matrix<double, 2, eskf::kDim> Hn = Eigen::Matrix<double, 2, eskf::kDim>::Zero();
-      Hn.block<2, 3>(0, nav::kV) = H6.leftCols<3>();
-      Hn.block<2, 3>(0, nav::kTheta) = H6.rightCols<3>();
       const double s2 = options_.wheel.nhc_sigma * options_.wheel.nhc_sigma;
-      Update<2>(rn, Hn, Eigen::Matrix2d::Identity() * s2, gate_nhc_, &wheel_counts_,
-                m.t);
+      Update<2>(rn, {{Block::kV, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}},
+                Eigen::Matrix2d::Identity() * s2, gate_nhc_, &wheel_counts_, m.t);
     }
   }
 }
@@ -290,17 +279,14 @@ void Eskf::AddStandstill(const StandstillMeasurement& m) {
     return;
   }
   // Standing: zero velocity, and the gyro reads its bias (zero-rate update), so nothing wanders.
-  Eigen::Matrix<double, 3, 1> r = x_.v_w;
-  Eigen::Matrix<double, 3, eskf::kDim> H = Eigen::Matrix<double, 3, eskf::kDim>::Zero();
-  H.block<3, 3>(0, nav::kV).setIdentity();
+  const Eigen::Matrix<double, 3, 1> r = x_.v_w;
   const double sv = options_.standstill.velocity_sigma;
-  Update<3>(r, H, Mat3::Identity() * sv * sv, gate_zupt_, &zupt_counts_, m.t);
+  Update<3>(r, {{Block::kV, Mat3::Identity()}}, Mat3::Identity() * sv * sv, gate_zupt_, &zupt_counts_, m.t);
   if (rate_usable) {
-    Eigen::Matrix<double, 3, 1> rg = x_.bg - mean_gyro;
-    Eigen::Matrix<double, 3, eskf::kDim> Hg = Eigen::Matrix<double, 3, eskf::kDim>::Zero();
-    Hg.block<3, 3>(0, nav::kBg).setIdentity();
+    const Eigen::Matrix<double, 3, 1> rg = x_.bg - mean_gyro;
     const double sigma = 2.0 * options_.imu.gyro_noise_density / std::sqrt(T);
-    Update<3>(rg, Hg, Mat3::Identity() * sigma * sigma, gate_zero_rate_, &zupt_counts_, m.t);
+    Update<3>(rg, {{Block::kBg, Mat3::Identity()}}, Mat3::Identity() * sigma * sigma, gate_zero_rate_,
+              &zupt_counts_, m.t);
   }
 }
 
@@ -322,11 +308,11 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
     g_w_ = GravityWorld(g_w_.allFinite() ? g_w_.norm() : kStandardGravity);
     if (!std::isfinite(scale_)) scale_ = 1.0;
     P_.setZero();
-    P_.block<3, 3>(nav::kTheta, nav::kTheta).diagonal() << 0.05, 0.05, 1.0;
-    P_.block<3, 3>(nav::kBg, nav::kBg).diagonal().setConstant(std::pow(options_.imu.init_gyro_bias_sigma, 2));
-    P_.block<3, 3>(nav::kBa, nav::kBa).diagonal().setConstant(std::pow(options_.imu.init_acc_bias_sigma, 2));
+    BlockOf<Block::kTheta>(P_).diagonal() << 0.05, 0.05, 1.0;
+    BlockOf<Block::kBg>(P_).diagonal().setConstant(std::pow(options_.imu.init_gyro_bias_sigma, 2));
+    BlockOf<Block::kBa>(P_).diagonal().setConstant(std::pow(options_.imu.init_acc_bias_sigma, 2));
     if (options_.eskf.estimate_gravity) {
-      P_.block<3, 3>(eskf::kG, eskf::kG).diagonal().setConstant(std::pow(options_.eskf.gravity_sigma, 2));
+      BlockOf<Block::kG>(P_).diagonal().setConstant(std::pow(options_.eskf.gravity_sigma, 2));
     }
     if (options_.wheel.enabled && options_.wheel.estimate_scale) P_(eskf::kS, eskf::kS) = std::pow(options_.wheel.scale_sigma, 2);
   }
@@ -344,10 +330,10 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
 StateEstimate Eskf::Estimate() const {
   StateEstimate e;
   e.x = x_;
-  e.sigma_p = P_.block<3, 3>(nav::kP, nav::kP).diagonal().cwiseSqrt();
-  e.sigma_v = P_.block<3, 3>(nav::kV, nav::kV).diagonal().cwiseSqrt();
+  e.sigma_p = BlockOf<Block::kP>(P_).diagonal().cwiseSqrt();
+  e.sigma_v = BlockOf<Block::kV>(P_).diagonal().cwiseSqrt();
   const Mat3 R = x_.R_wb();
-  e.sigma_att = (R * P_.block<3, 3>(nav::kTheta, nav::kTheta) * R.transpose()).diagonal().cwiseSqrt();
+  e.sigma_att = (R * BlockOf<Block::kTheta>(P_) * R.transpose()).diagonal().cwiseSqrt();
   e.odom_scale = scale_;
   return e;
 }

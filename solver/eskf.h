@@ -1,8 +1,9 @@
 // Error-state Kalman filter (reference ch. 3). Nominal state: NavState, gravity g_w, odometer scale s.
 // Error state (19): δp, δv, δθ, δbg, δba, δg, δs — right perturbation (DESIGN §2), so the first 15 are
-// the NavState tangent. Prediction at IMU rate through the shared kernel (core/imu_kernel.h); updates
-// linearise the shared measurement models (core/*_model.h) with core/linearize.h; Joseph-form covariance
-// update, χ² innovation gates, reset with covariance projection.
+// the NavState tangent; the layout is declared once in solver/eskf_state.h. Prediction at IMU rate through
+// the shared kernel (core/imu_kernel.h); updates linearise the shared measurement models (core/*_model.h)
+// with core/linearize.h and all go through one helper (solver/eskf_update.h): Jacobians per block,
+// Joseph-form covariance update, χ² innovation gates; then reset with covariance projection.
 //
 // Robustness (config standstill.*, watchdog.*, imu.max_gap_s):
 // - Standstill (AddStandstill, from the session's detector): zero-velocity update (σ standstill.velocity_
@@ -19,21 +20,19 @@
 //   (watchdog.resets: time, reason) say so.
 #pragma once
 
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "solver/estimator_options.h"
+#include "core/imu_kernel.h"
+#include "solver/eskf_state.h"
+#include "solver/eskf_update.h"
 #include "solver/estimator.h"
+#include "solver/estimator_options.h"
 
 namespace gins {
-
-namespace eskf {
-constexpr int kG = 15;
-constexpr int kS = 18;
-constexpr int kDim = 19;
-}  // namespace eskf
 
 class Eskf : public Estimator {
  public:
@@ -61,9 +60,14 @@ class Eskf : public Estimator {
   // Propagates nominal state and covariance to time t with the given rate and specific force held
   // (default: the last IMU sample).
   void Propagate(double t, const ImuSample* held = nullptr);
-  // Gated Kalman update with residual r = h(x) − z and its Jacobian H; returns false if rejected.
+  // P through one kernel step (J) of dt; gap: the step coasted over an IMU gap.
+  void PropagateCovariance(const ImuStepJacobians& J, double dt, bool gap);
+  // The random walks of the driving and passive blocks over dt.
+  void AddRandomWalks(double dt);
+  // Gated Kalman update with residual r = h(x) − z and its Jacobian per block it touches (eskf_update.h),
+  // injected when accepted; returns false if rejected (counted in counts).
   template <int M>
-  bool Update(const Eigen::Matrix<double, M, 1>& r, const Eigen::Matrix<double, M, eskf::kDim>& H,
+  bool Update(const Eigen::Matrix<double, M, 1>& r, std::initializer_list<eskf::BlockJacobian<M>> H,
               const Eigen::Matrix<double, M, M>& R, double gate, MeasurementCounts* counts, double t);
   void Inject(const VecP& dx);
   // Watchdog: after a GNSS position update (accepted or not); returns true if it re-initialised.

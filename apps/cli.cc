@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "apps/convert_command.h"
 #include "apps/eval_command.h"
 #include "config/config_loader.h"
 #include "core/io/log_reader.h"
@@ -107,6 +108,8 @@ int RunCli(int argc, const char* const* argv) {
 
   EvalRequest eval_req;  // gins eval (apps/eval_command.h)
   auto* eval = AddEvalCommand(app, &eval_req);
+  ConvertRequest convert_req;  // gins convert (apps/convert_command.h)
+  auto* convert = AddConvertCommand(app, &convert_req);
 
   try {
     app.parse(argc, argv);
@@ -117,6 +120,7 @@ int RunCli(int argc, const char* const* argv) {
   }
 
   if (*eval) return RunEval(eval_req);
+  if (*convert) return RunConvert(convert_req);
   try {
     if (*run) {
       const Options options = LoadOptions(config_path);

@@ -13,16 +13,18 @@
 // input.max_time_jump_s ahead of the newest time read is a time_jump (a corrupted far-future time stamp
 // then costs one line, not every later one); after 10 consecutive records that all jumped and agree with
 // each other, the log's clock really jumped and the reader takes the new time base.
+// Code: ParseLogLine in log_line.cc, the streaming reader in log_reader.cc, the line source underneath in
+// text_input.cc.
 #pragma once
 
 #include <cstdint>
 #include <map>
 #include <memory>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "core/io/text_input.h"
 #include "core/measurements.h"
 
 namespace gins {
@@ -38,12 +40,20 @@ struct InputOptions {
                                      // damage (time_jump); 0 = no limit
 };
 
-// Bad or unreadable input at the program boundary. what() is one line: "<file>:<line>: <reason>" (or
-// "<file>: <reason>" when no line applies).
-class InputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+// Plausibility limits of a log record (ParseLogLine). The reader sees only InputOptions, so they are fixed;
+// gyro and acc match the ImuOptions defaults (max_gyro, max_acc). Anything beyond them is a corrupted field,
+// not a measurement. Writers of logs (core/io/i2nav.h) check against the same limits.
+namespace log_limits {
+inline constexpr double kMaxAbsGyro = 35.0;         // rad/s, per axis
+inline constexpr double kMaxAbsAcc = 200.0;         // m/s², per axis
+inline constexpr double kMaxAbsLatDeg = 90.0;       // inclusive
+inline constexpr double kMaxAbsLonDeg = 180.0;      // inclusive
+inline constexpr double kMinAlt = -1000.0;          // m, exclusive
+inline constexpr double kMaxAlt = 1e5;              // m, exclusive
+inline constexpr double kMaxSigma = 1e4;            // m, exclusive; σ must also be > 0 (a zero σ breaks a solver)
+inline constexpr double kMaxAbsHeadingDeg = 360.0;  // inclusive; normalised into [0, 360)
+inline constexpr double kMaxAbsPulses = 1e7;        // exclusive
+}  // namespace log_limits
 
 struct LogRecord {
   enum class Type { kImu, kOdom, kGnss };
@@ -54,6 +64,9 @@ struct LogRecord {
   GnssRecord gnss;    // valid when type == kGnss
   double t() const;
 };
+
+// "IMU", "ODOM" or "GNSS": the record's type token.
+const char* LogRecordTypeName(LogRecord::Type type);
 
 struct InputIssue {
   uint64_t line = 0;

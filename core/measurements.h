@@ -34,6 +34,22 @@ struct GnssRecord {
   Vec3 sigma_enu = Vec3::Zero();  // 1-σ position error (east, north, up), m
 };
 
+// GNSS (Doppler) velocity as logged (GVEL records): the antenna's velocity in the local East-North-Up frame
+// at the fix, with an optional 1-σ per axis.
+struct GvelRecord {
+  double t = 0.0;
+  Vec3 v_enu = Vec3::Zero();     // m/s
+  bool has_sigma = false;
+  Vec3 sigma_enu = Vec3::Zero();  // m/s
+};
+
+// A GNSS velocity in the world frame, ready for an estimator.
+struct GvelMeasurement {
+  double t = 0.0;
+  Vec3 v_w = Vec3::Zero();        // antenna velocity in w, m/s
+  Vec3 sigma_w = Vec3::Ones();    // 1-σ per ENU axis, m/s
+};
+
 // A GNSS fix in the world frame, ready for an estimator.
 struct GnssMeasurement {
   double t = 0.0;

@@ -7,6 +7,11 @@
 // Outputs: the final estimate of each keyframe when it leaves the window, with IMU-rate states between
 // keyframes propagated from it (final stream), and the newest keyframe after each solve (online stream).
 //
+// In parts: the keyframes and their state blocks (solver/keyframe.h), first-estimate Jacobians
+// (factors/fej_cost.h), one attacher per measurement type (solver/smoother_attachers.h), the marginaliser
+// (solver/marginalizer.h) and the output with covariance recovery (solver/smoother_output.h); this class
+// integrates the IMU, decides the keyframes, solves, and runs the watchdog.
+//
 // Robustness (config standstill.*, watchdog.*, imu.max_gap_s):
 // - Standstill (AddStandstill, from the session's detector): a zero-velocity factor on each keyframe inside
 //   a standstill, and a zero-motion factor (no translation, 0.1 mm; no rotation, the gyro noise over the
@@ -24,17 +29,18 @@
 
 #include <ceres/ceres.h>
 
-#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "solver/estimator_options.h"
 #include "core/preintegration.h"
 #include "factors/pose_manifold.h"
 #include "solver/estimator.h"
+#include "solver/estimator_options.h"
+#include "solver/keyframe.h"
+#include "solver/smoother_attachers.h"
 
 namespace gins {
 
@@ -56,56 +62,38 @@ class Smoother : public Estimator {
   NavState NewestState() const;
 
  private:
-  struct Keyframe;
-  class FejCost;
-  // One IMU step: the rate and specific force held over dt.
-  struct HeldSample {
-    ImuSample sample;
-    double dt;
-  };
-
-  // Adds a factor wrapped for first-estimate Jacobians; each block is named with its keyframe.
-  ceres::ResidualBlockId AddFactor(ceres::CostFunction* cost, ceres::LossFunction* loss,
-                                   const std::vector<std::pair<const Keyframe*, double*>>& blocks);
   void IntegrateTo(double t, const ImuSample* held = nullptr);
-  Keyframe* CreateKeyframe(double t);
-  void AttachWheel(Keyframe* kf);
-  void AttachStandstill(Keyframe* kf);
+  Keyframe& CreateKeyframe(double t);
+  ceres::ResidualBlockId AddImuFactor(Keyframe& prev, Keyframe& kf);
   void WatchGnss(double t, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
   // One Ceres solve of the window with the configured options; false if the solution is not usable.
   bool Solve();
   void SolveAndSlide();
-  void CheckGnssResiduals();
-  void CheckStandstillResiduals();
   void ReintegrateIfNeeded();
   void MarginalizeOldest();
-  void EmitFinal(const Keyframe& kf, const Keyframe* next, const Mat15* cov);
-  NavState StateOf(const Keyframe& kf) const;
-  StateEstimate EstimateOf(const Keyframe& kf, const Mat15* cov) const;
-  void AddPrior(const Keyframe& kf, const Mat15& P0);
+  // A keyframe leaves the window: its final estimate and the IMU-rate states after it.
+  void OutputFinal(const Keyframe& kf, const Keyframe* next, const Mat15* cov);
 
   EstimatorOptions options_;
   StateCallback on_final_, on_online_;
   Vec3 g_w_ = Vec3::Zero();
   bool initialized_ = false;
 
-  std::unique_ptr<ceres::Problem> problem_;
-  PoseManifold pose_manifold_;
-  std::unique_ptr<ceres::LossFunction> gnss_loss_, standstill_loss_;
-  std::deque<std::unique_ptr<Keyframe>> window_;
-  ceres::ResidualBlockId prior_id_ = nullptr;
+  KeyframeStore window_;
+  std::unique_ptr<ceres::Problem> problem_;  // after window_: the problem goes first, its blocks are there
 
   // Between the newest keyframe and now.
   std::shared_ptr<Preintegration> preint_;
-  std::vector<HeldSample> interval_samples_;
+  std::vector<HeldImuSample> interval_samples_;
   std::optional<ImuSample> last_imu_;
   double t_now_ = 0.0;
   NavState pred_;  // IMU-propagated from the newest keyframe, for initial values
-  std::optional<WheelMeasurement> last_wheel_;
-  std::optional<StandstillMeasurement> last_standstill_;
-  double gnss_gate_ = 0.0, zupt_gate_ = 0.0;
   double initial_scale_ = 1.0;  // odometer scale of the first keyframe (kept across a watchdog reset)
+
+  // The measurements' attachers, in the order of their checks after a solve.
+  std::vector<std::unique_ptr<MeasurementAttacher>> attachers_;
+  AttachContext context_;
 
   GnssWatchdog watchdog_;
   std::string reset_reason_;      // set by the checks, acted on at the end of AddGnss
@@ -116,10 +104,9 @@ class Smoother : public Estimator {
 
   // Statistics.
   uint64_t solves_ = 0, iterations_ = 0, marginalizations_ = 0, keyframes_ = 0, reintegrations_ = 0;
-  uint64_t gnss_decimated_ = 0, solver_failures_ = 0, zero_motion_factors_ = 0;
+  uint64_t gnss_decimated_ = 0, solver_failures_ = 0;
   double last_scale_ = 1.0;  // of the last keyframe to leave the window
   double solve_time_ = 0.0, max_solve_time_ = 0.0, marg_time_ = 0.0;
-  MeasurementCounts gnss_counts_, heading_counts_, wheel_counts_, zupt_counts_;
 };
 
 }  // namespace gins

@@ -1,0 +1,247 @@
+#include "solver/keyframe.h"
+
+#include <glog/logging.h>
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <utility>
+
+#include "factors/bias_rw_factor.h"
+#include "factors/fej_cost.h"
+#include "factors/scale_rw_factor.h"
+
+namespace gins {
+
+namespace keyframe_blocks {
+
+void PoseToNav(const double* values, NavState* x) {
+  x->p_wb = Eigen::Map<const Vec3>(values + pose::kP);
+  x->q_wb = Eigen::Map<const Quat>(values + pose::kQ).normalized();
+}
+void PoseFromNav(const NavState& x, double* values) { SetPose(x.p_wb, x.q_wb, values); }
+void VelocityToNav(const double* values, NavState* x) { x->v_w = Eigen::Map<const Vec3>(values); }
+void VelocityFromNav(const NavState& x, double* values) {
+  Eigen::Map<Vec3> v_w(values);
+  v_w = x.v_w;
+}
+void BiasToNav(const double* values, NavState* x) {
+  x->bg = Eigen::Map<const Vec3>(values);
+  x->ba = Eigen::Map<const Vec3>(values + 3);
+}
+void BiasFromNav(const NavState& x, double* values) {
+  Eigen::Map<Vec3> bg(values), ba(values + 3);
+  bg = x.bg;
+  ba = x.ba;
+}
+bool ScaleEstimated(const EstimatorOptions& options) { return options.wheel.enabled && options.wheel.estimate_scale; }
+double ScalePriorSigma(const EstimatorOptions& options) { return options.wheel.scale_sigma; }
+ceres::CostFunction* BiasRandomWalk(const EstimatorOptions& options, double dt) {
+  return BiasRwFactor::Create(options.imu.gyro_bias_rw, options.imu.acc_bias_rw, dt);
+}
+ceres::CostFunction* ScaleRandomWalk(const EstimatorOptions& options, double dt) {
+  return ScaleRwFactor::Create(options.wheel.scale_rw, dt);
+}
+
+}  // namespace keyframe_blocks
+
+namespace {
+
+// The table is indexed by BlockType, and the blocks' tangents are what their kinds say.
+constexpr bool TableIsConsistent() {
+  for (int i = 0; i < kNumBlockTypes; ++i) {
+    const BlockSpec& s = kBlockSpecs[i];
+    if (static_cast<int>(s.type) != i) return false;
+    const int tangent = s.kind == BlockKind::kPose ? pose::kTangent : s.ambient_size;
+    if (s.tangent_size != tangent) return false;
+    int covered = 0;
+    for (int r = 0; r < s.num_runs; ++r) covered += s.runs[r].size;
+    if (s.num_runs > 0 && covered != s.tangent_size) return false;
+    if ((s.to_nav == nullptr) != (s.num_runs == 0) || (s.from_nav == nullptr) != (s.num_runs == 0)) return false;
+    if (s.num_runs == 0 && s.prior_sigma == nullptr) return false;
+  }
+  return true;
+}
+static_assert(TableIsConsistent(), "kBlockSpecs: rows out of enum order or inconsistent sizes");
+
+}  // namespace
+
+std::vector<int> NavIndexOfTangent(const std::vector<BlockType>& types) {
+  std::vector<int> index;
+  for (BlockType type : types) {
+    const BlockSpec& spec = SpecOf(type);
+    const size_t start = index.size();
+    index.resize(start + spec.tangent_size, -1);
+    for (int r = 0; r < spec.num_runs; ++r) {
+      const NavRun& run = spec.runs[r];
+      for (int k = 0; k < run.size; ++k) index[start + run.tangent_offset + k] = run.nav_offset + k;
+    }
+  }
+  return index;
+}
+
+void Keyframe::FreezeFirstEstimates() {
+  std::copy(values, values + kKeyframeAmbientSize, first_estimates);
+  fej = true;
+}
+
+NavState Keyframe::State() const {
+  NavState x;
+  x.t = t;
+  for (const BlockSpec& spec : kBlockSpecs) {
+    if (spec.to_nav != nullptr) spec.to_nav(block(spec.type), &x);
+  }
+  return x;
+}
+
+void Keyframe::SetState(const NavState& x) {
+  for (const BlockSpec& spec : kBlockSpecs) {
+    if (spec.from_nav != nullptr) spec.from_nav(x, block(spec.type));
+  }
+}
+
+KeyframeStore::KeyframeStore(const EstimatorOptions& options) : options_(options) {
+  for (const BlockSpec& spec : kBlockSpecs) {
+    estimated_[static_cast<int>(spec.type)] = spec.estimated == nullptr || spec.estimated(options);
+  }
+}
+
+void KeyframeStore::Reset(ceres::Problem* problem) {
+  window_.clear();
+  problem_ = problem;
+}
+
+std::unique_ptr<Keyframe> KeyframeStore::Make(double t, const NavState& x) const {
+  auto kf = std::make_unique<Keyframe>();
+  kf->id = next_id_;
+  kf->t = t;
+  kf->SetState(x);
+  for (const BlockSpec& spec : kBlockSpecs) {
+    if (spec.from_nav != nullptr) continue;
+    double* b = kf->block(spec.type);
+    if (window_.empty()) {
+      std::fill(b, b + spec.ambient_size, spec.initial_value);
+    } else {
+      const double* prev = back().block(spec.type);
+      std::copy(prev, prev + spec.ambient_size, b);
+    }
+  }
+  return kf;
+}
+
+ceres::Manifold* KeyframeStore::ManifoldOf(const BlockSpec& spec) {
+  return spec.kind == BlockKind::kPose ? &pose_manifold_ : nullptr;
+}
+
+Keyframe& KeyframeStore::Push(std::unique_ptr<Keyframe> kf) {
+  CHECK(problem_ != nullptr) << "KeyframeStore::Push before Reset";
+  CHECK_EQ(kf->id, next_id_) << "a keyframe from Make, pushed once";
+  ++next_id_;
+  for (const BlockSpec& spec : kBlockSpecs) {
+    ceres::Manifold* manifold = ManifoldOf(spec);
+    if (manifold != nullptr) {
+      problem_->AddParameterBlock(kf->block(spec.type), spec.ambient_size, manifold);
+    } else {
+      problem_->AddParameterBlock(kf->block(spec.type), spec.ambient_size);
+    }
+  }
+  for (const BlockSpec& spec : kBlockSpecs) {
+    if (!estimated(spec.type)) problem_->SetParameterBlockConstant(kf->block(spec.type));
+  }
+  window_.push_back(std::move(kf));
+  return *window_.back();
+}
+
+void KeyframeStore::PopOldest() {
+  CHECK(!window_.empty());
+  for (double* b : Blocks(front())) CHECK(!problem_->HasParameterBlock(b)) << "PopOldest: blocks still in the problem";
+  window_.pop_front();
+}
+
+std::vector<double*> KeyframeStore::Blocks(Keyframe& kf) const {
+  std::vector<double*> blocks;
+  for (const BlockSpec& spec : kBlockSpecs) blocks.push_back(kf.block(spec.type));
+  return blocks;
+}
+
+std::vector<double*> KeyframeStore::EstimatedBlocks(Keyframe& kf) const {
+  std::vector<double*> blocks;
+  for (const BlockSpec& spec : kBlockSpecs) {
+    if (estimated(spec.type)) blocks.push_back(kf.block(spec.type));
+  }
+  return blocks;
+}
+
+std::vector<double*> KeyframeStore::EstimatedBlocks() {
+  std::vector<double*> blocks;
+  for (auto& kf : window_) {
+    for (double* b : EstimatedBlocks(*kf)) blocks.push_back(b);
+  }
+  return blocks;
+}
+
+std::vector<BlockType> KeyframeStore::EstimatedTypes() const {
+  std::vector<BlockType> types;
+  for (const BlockSpec& spec : kBlockSpecs) {
+    if (estimated(spec.type)) types.push_back(spec.type);
+  }
+  return types;
+}
+
+ceres::ResidualBlockId KeyframeStore::AddFactor(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                                                const std::vector<BlockRef>& blocks) {
+  std::vector<FejCost::Block> fej;
+  std::vector<double*> params;
+  for (const BlockRef& ref : blocks) {
+    fej.push_back({ref.kf->first_estimate(ref.type), &ref.kf->fej, SpecOf(ref.type).kind == BlockKind::kPose});
+    params.push_back(ref.kf->block(ref.type));
+  }
+  return problem_->AddResidualBlock(new FejCost(cost, std::move(fej)), loss, params);
+}
+
+ceres::ResidualBlockId KeyframeStore::AddPrior(Keyframe& kf, const Mat15& P0) {
+  // The covariance in the estimated blocks' tangent order; blocks outside NavState uncorrelated.
+  const std::vector<BlockType> types = EstimatedTypes();
+  const std::vector<int> nav = NavIndexOfTangent(types);
+  const int n = static_cast<int>(nav.size());
+  MatX P = MatX::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      if (nav[i] >= 0 && nav[j] >= 0) P(i, j) = P0(nav[i], nav[j]);
+    }
+  }
+  int column = 0;
+  for (BlockType type : types) {
+    const BlockSpec& spec = SpecOf(type);
+    if (spec.num_runs == 0) {
+      const double sigma = spec.prior_sigma(options_);
+      P.diagonal().segment(column, spec.tangent_size).setConstant(sigma * sigma);
+    }
+    column += spec.tangent_size;
+  }
+  const MatX info = P.inverse();
+  const Eigen::LLT<MatX> llt(0.5 * (info + info.transpose()));
+  const MatX J = llt.matrixU();  // JᵀJ = info
+  std::vector<PriorBlock> blocks;
+  for (BlockType type : types) {
+    const BlockSpec& spec = SpecOf(type);
+    PriorBlock b;
+    b.kind = spec.kind;
+    b.ambient_size = spec.ambient_size;
+    b.tangent_size = TangentSizeOf(spec.kind, spec.ambient_size);
+    b.x0.assign(kf.block(type), kf.block(type) + spec.ambient_size);
+    blocks.push_back(std::move(b));
+  }
+  return problem_->AddResidualBlock(new MarginalizationPrior(std::move(blocks), J, VecX::Zero(n)), nullptr,
+                                    EstimatedBlocks(kf));
+}
+
+void KeyframeStore::AddRandomWalks(Keyframe& prev, Keyframe& kf) {
+  const double dt = kf.t - prev.t;
+  for (const BlockSpec& spec : kBlockSpecs) {
+    if (spec.random_walk == nullptr || !estimated(spec.type)) continue;
+    AddFactor(spec.random_walk(options_, dt), nullptr, {{&prev, spec.type}, {&kf, spec.type}});
+  }
+}
+
+}  // namespace gins

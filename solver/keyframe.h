@@ -1,0 +1,207 @@
+// The smoother's keyframes and their state blocks, as data. One row per block type (kBlockSpecs) gives its
+// sizes, its manifold, where its tangent sits in the NavState tangent (δp, δv, δθ, δbg, δba) and whether the
+// options estimate it; the keyframe store adds a keyframe's blocks to the problem, lists them, builds the
+// initial prior and wraps factors for first-estimate Jacobians by iterating that table. Adding a state to
+// the keyframes is one row (and its enum value), not an edit wherever the blocks are listed.
+#pragma once
+
+#include <ceres/problem.h>
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <vector>
+
+#include "core/nav_state.h"
+#include "core/preintegration.h"
+#include "factors/marginalization_prior.h"
+#include "factors/pose_manifold.h"
+#include "solver/estimator_options.h"
+
+namespace gins {
+
+// The state blocks of one keyframe, in table order (the order of kBlockSpecs, of Keyframe::values, of every
+// list of a keyframe's blocks, and so of the solver's elimination order).
+enum class BlockType { kPose, kVelocity, kBias, kScale };
+inline constexpr int kNumBlockTypes = 4;
+
+// Coordinates [tangent_offset, tangent_offset + size) of a block's tangent sit at
+// [nav_offset, nav_offset + size) of the NavState tangent.
+struct NavRun {
+  int tangent_offset = 0;
+  int nav_offset = 0;
+  int size = 0;
+};
+
+struct BlockSpec {
+  BlockType type;
+  const char* name;
+  int ambient_size;
+  int tangent_size;
+  BlockKind kind;  // kPose: PoseManifold; kEuclidean: no manifold
+  // Where the tangent sits in NavState: the pose block is (δp, δθ), so two runs; none (num_runs 0) for a
+  // block outside NavState.
+  int num_runs;
+  std::array<NavRun, 2> runs;
+  // NavState <-> block values; null for a block outside NavState.
+  void (*to_nav)(const double* values, NavState* x);
+  void (*from_nav)(const NavState& x, double* values);
+  // Whether the options estimate the block; one that is not is held constant in the problem and left out
+  // of priors, orderings and covariances. Null: always estimated.
+  bool (*estimated)(const EstimatorOptions& options);
+  // For a block outside NavState: its value on a first keyframe (later keyframes start from the previous
+  // keyframe's, a random walk's mean) and its 1-σ in the initial prior.
+  double initial_value;
+  double (*prior_sigma)(const EstimatorOptions& options);
+  // The factor between this block of two consecutive keyframes dt apart, when it is a random walk; null
+  // for a block the IMU factor links (pose, velocity).
+  ceres::CostFunction* (*random_walk)(const EstimatorOptions& options, double dt);
+};
+
+namespace keyframe_blocks {
+void PoseToNav(const double* values, NavState* x);
+void PoseFromNav(const NavState& x, double* values);
+void VelocityToNav(const double* values, NavState* x);
+void VelocityFromNav(const NavState& x, double* values);
+void BiasToNav(const double* values, NavState* x);
+void BiasFromNav(const NavState& x, double* values);
+// The odometer scale is estimated only with wheels and wheel.estimate_scale.
+bool ScaleEstimated(const EstimatorOptions& options);
+double ScalePriorSigma(const EstimatorOptions& options);
+ceres::CostFunction* BiasRandomWalk(const EstimatorOptions& options, double dt);
+ceres::CostFunction* ScaleRandomWalk(const EstimatorOptions& options, double dt);
+}  // namespace keyframe_blocks
+
+// clang-format off
+inline constexpr std::array<BlockSpec, kNumBlockTypes> kBlockSpecs = {{
+    {BlockType::kPose, "pose", pose::kAmbient, pose::kTangent, BlockKind::kPose,
+     2, {{{pose::kP, nav::kP, 3}, {pose::kTheta, nav::kTheta, 3}}},
+     &keyframe_blocks::PoseToNav, &keyframe_blocks::PoseFromNav,
+     nullptr, 0.0, nullptr, nullptr},
+    {BlockType::kVelocity, "velocity", 3, 3, BlockKind::kEuclidean,
+     1, {{{0, nav::kV, 3}, {}}},
+     &keyframe_blocks::VelocityToNav, &keyframe_blocks::VelocityFromNav,
+     nullptr, 0.0, nullptr, nullptr},
+    {BlockType::kBias, "bias", 6, 6, BlockKind::kEuclidean,
+     1, {{{0, nav::kBg, 6}, {}}},  // (bg, ba): contiguous in NavState too
+     &keyframe_blocks::BiasToNav, &keyframe_blocks::BiasFromNav,
+     nullptr, 0.0, nullptr, &keyframe_blocks::BiasRandomWalk},
+    {BlockType::kScale, "scale", 1, 1, BlockKind::kEuclidean,
+     0, {},
+     nullptr, nullptr,
+     &keyframe_blocks::ScaleEstimated, 1.0, &keyframe_blocks::ScalePriorSigma, &keyframe_blocks::ScaleRandomWalk},
+}};
+// clang-format on
+
+constexpr const BlockSpec& SpecOf(BlockType type) { return kBlockSpecs[static_cast<int>(type)]; }
+
+// Offset of a block in a keyframe's values (blocks back to back in table order), and their total size.
+constexpr int AmbientOffsetOfRow(int row) {
+  int offset = 0;
+  for (int i = 0; i < row; ++i) offset += kBlockSpecs[i].ambient_size;
+  return offset;
+}
+constexpr int AmbientOffset(BlockType type) { return AmbientOffsetOfRow(static_cast<int>(type)); }
+inline constexpr int kKeyframeAmbientSize = AmbientOffsetOfRow(kNumBlockTypes);
+
+// The NavState index of each tangent coordinate of the given blocks, concatenated in their order (-1 for a
+// coordinate outside NavState).
+std::vector<int> NavIndexOfTangent(const std::vector<BlockType>& types);
+
+// One IMU step: the rate and specific force held over dt.
+struct HeldImuSample {
+  ImuSample sample;
+  double dt;
+};
+
+struct Keyframe {
+  uint64_t id = 0;  // from the store: increasing, never reused (attachers key their records on it)
+  double t = 0.0;
+  double values[kKeyframeAmbientSize] = {};  // the blocks, back to back in table order: the parameter memory
+  // First estimates: once a marginalisation prior is built on this keyframe, every other factor on it
+  // evaluates its Jacobians here, at the prior's linearisation point, so the prior and the factors agree
+  // on what is observable (no spurious information in yaw or position).
+  bool fej = false;
+  double first_estimates[kKeyframeAmbientSize] = {};
+
+  std::shared_ptr<const Preintegration> preint;  // previous keyframe -> this one
+  std::vector<HeldImuSample> steps_from_prev;    // for the IMU-rate output between keyframes
+  ceres::ResidualBlockId imu_id = nullptr;       // the IMU factor from the previous keyframe
+  bool still_from_prev = false;  // stood still since the previous keyframe (a zero-motion factor joins them)
+
+  double* block(BlockType type) { return values + AmbientOffset(type); }
+  const double* block(BlockType type) const { return values + AmbientOffset(type); }
+  const double* first_estimate(BlockType type) const { return first_estimates + AmbientOffset(type); }
+  void FreezeFirstEstimates();
+  NavState State() const;            // t and the NavState blocks (quaternion normalised)
+  void SetState(const NavState& x);  // the NavState blocks (not t)
+};
+
+// One block of one keyframe, as a factor's parameter.
+struct BlockRef {
+  Keyframe* kf;
+  BlockType type;
+};
+
+// The window's keyframes, oldest first, and their blocks in a Ceres problem.
+class KeyframeStore {
+ public:
+  explicit KeyframeStore(const EstimatorOptions& options);
+
+  // Empties the window; the blocks of the keyframes pushed from now on go to `problem` (not owned).
+  void Reset(ceres::Problem* problem);
+  ceres::Problem* problem() const { return problem_; }
+  bool estimated(BlockType type) const { return estimated_[static_cast<int>(type)]; }
+
+  // A keyframe at t with the NavState blocks from x, and the others from the newest keyframe (or their
+  // initial value in an empty window); not in the window yet.
+  std::unique_ptr<Keyframe> Make(double t, const NavState& x) const;
+  // Appends kf as the newest keyframe and adds its blocks to the problem in table order (those not
+  // estimated held constant).
+  Keyframe& Push(std::unique_ptr<Keyframe> kf);
+  // Drops the oldest keyframe; its residuals and blocks must be out of the problem already (Marginalizer:
+  // residuals first, in program order, for determinism).
+  void PopOldest();
+  void Clear() { window_.clear(); }
+
+  size_t size() const { return window_.size(); }
+  bool empty() const { return window_.empty(); }
+  Keyframe& operator[](size_t i) { return *window_[i]; }
+  const Keyframe& operator[](size_t i) const { return *window_[i]; }
+  Keyframe& front() { return *window_.front(); }
+  const Keyframe& front() const { return *window_.front(); }
+  Keyframe& back() { return *window_.back(); }
+  const Keyframe& back() const { return *window_.back(); }
+
+  // A keyframe's blocks in table order: all of them, or the estimated ones.
+  std::vector<double*> Blocks(Keyframe& kf) const;
+  std::vector<double*> EstimatedBlocks(Keyframe& kf) const;
+  // The estimated blocks of the whole window, oldest keyframe first: the elimination order, and the
+  // columns of a covariance recovery.
+  std::vector<double*> EstimatedBlocks();
+  // The block types EstimatedBlocks(kf) lists, in its order.
+  std::vector<BlockType> EstimatedTypes() const;
+
+  // Adds a factor on the given blocks, wrapped for first-estimate Jacobians (factors/fej_cost.h): each
+  // block linearises at its keyframe's first estimate once the keyframe has one.
+  ceres::ResidualBlockId AddFactor(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                                   const std::vector<BlockRef>& blocks);
+  // The covariance P0 (NavState tangent order) as a prior on kf's estimated blocks; a block outside
+  // NavState gets its spec's prior_sigma, uncorrelated.
+  ceres::ResidualBlockId AddPrior(Keyframe& kf, const Mat15& P0);
+  // The random-walk factors from prev to kf of the estimated blocks that have one, in table order.
+  void AddRandomWalks(Keyframe& prev, Keyframe& kf);
+
+ private:
+  ceres::Manifold* ManifoldOf(const BlockSpec& spec);
+
+  EstimatorOptions options_;
+  std::array<bool, kNumBlockTypes> estimated_{};
+  ceres::Problem* problem_ = nullptr;
+  PoseManifold pose_manifold_;
+  std::deque<std::unique_ptr<Keyframe>> window_;
+  uint64_t next_id_ = 0;
+};
+
+}  // namespace gins

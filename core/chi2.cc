@@ -1,6 +1,7 @@
 #include "core/chi2.h"
 
 #include <cmath>
+#include <limits>
 
 namespace gins {
 namespace {
@@ -40,6 +41,10 @@ double RegularizedGammaP(double a, double x) {
 }  // namespace
 
 double Chi2Cdf(double x, int dof) { return RegularizedGammaP(0.5 * dof, 0.5 * x); }
+
+double Chi2Gate(double probability, int dof) {
+  return probability > 0.0 ? Chi2Quantile(probability, dof) : std::numeric_limits<double>::infinity();
+}
 
 double Chi2Quantile(double p, int dof) {
   double lo = 0.0, hi = 1.0;

@@ -144,6 +144,85 @@ int MarginalizationInfo::FindBlock(const double* values) const {
   return -1;
 }
 
+int MarginalizationInfo::LayOutTangents(int* n_total) {
+  for (Block& b : blocks_) b.used = false;
+  for (const Residual& res : residuals_) {
+    for (double* p : res.parameter_blocks) blocks_[FindBlock(p)].used = true;
+  }
+  int n = 0;
+  for (Block& b : blocks_) {
+    if (b.used && b.role == Role::kMarginalize) {
+      b.offset = n;
+      n += b.tangent_size;
+    }
+  }
+  const int n_marg = n;
+  for (Block& b : blocks_) {
+    if (b.used && b.role == Role::kKeep) {
+      b.offset = n;
+      n += b.tangent_size;
+    }
+  }
+  *n_total = n;
+  return n_marg;
+}
+
+bool MarginalizationInfo::Accumulate(const Residual& res, MatX* H, VecX* b_vec) const {
+  const int m = res.cost->num_residuals();
+  const size_t num_blocks = res.parameter_blocks.size();
+  std::vector<int> index(num_blocks);
+  std::vector<RowMajorMat> J_amb(num_blocks);
+  std::vector<double*> jac_ptrs(num_blocks, nullptr);
+  for (size_t i = 0; i < num_blocks; ++i) {
+    index[i] = FindBlock(res.parameter_blocks[i]);
+    const Block& blk = blocks_[index[i]];
+    if (blk.role == Role::kConstant) continue;
+    J_amb[i].resize(m, blk.ambient_size);
+    jac_ptrs[i] = J_amb[i].data();
+  }
+  VecX r(m);
+  if (!res.cost->Evaluate(res.parameter_blocks.data(), r.data(), jac_ptrs.data())) return false;
+  if (!r.allFinite()) return false;
+  for (size_t i = 0; i < num_blocks; ++i) {
+    if (jac_ptrs[i] != nullptr && !J_amb[i].allFinite()) return false;
+  }
+
+  // Robust loss: rescale as Ceres's Corrector does, so that JᵀJ and Jᵀr are those the solver sees.
+  if (res.loss != nullptr) {
+    const double sq_norm = r.squaredNorm();
+    double rho[3];
+    res.loss->Evaluate(sq_norm, rho);
+    if (!(rho[1] > 0.0) || !std::isfinite(rho[1])) return false;
+    const double sqrt_rho1 = std::sqrt(rho[1]);
+    double residual_scaling = sqrt_rho1, alpha_sq_norm = 0.0;
+    if (sq_norm > 0.0 && rho[2] > 0.0) {
+      const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * sq_norm * rho[2] / rho[1]);
+      residual_scaling = sqrt_rho1 / (1.0 - alpha);
+      alpha_sq_norm = alpha / sq_norm;
+    }
+    for (size_t i = 0; i < num_blocks; ++i) {
+      if (jac_ptrs[i] == nullptr) continue;
+      const Eigen::RowVectorXd rT_J = r.transpose() * J_amb[i];
+      J_amb[i] = sqrt_rho1 * (J_amb[i] - alpha_sq_norm * r * rT_J);
+    }
+    r *= residual_scaling;
+  }
+
+  for (size_t i = 0; i < num_blocks; ++i) {
+    if (jac_ptrs[i] == nullptr) continue;
+    const Block& bi = blocks_[index[i]];
+    const MatX J_i = J_amb[i] * PlusJacobianAt(bi.kind, bi.ambient_size, bi.values);
+    b_vec->segment(bi.offset, bi.tangent_size) += J_i.transpose() * r;
+    for (size_t j = 0; j < num_blocks; ++j) {
+      if (jac_ptrs[j] == nullptr) continue;
+      const Block& bj = blocks_[index[j]];
+      const MatX J_j = J_amb[j] * PlusJacobianAt(bj.kind, bj.ambient_size, bj.values);
+      H->block(bi.offset, bj.offset, bi.tangent_size, bj.tangent_size) += J_i.transpose() * J_j;
+    }
+  }
+  return true;
+}
+
 bool MarginalizationInfo::Marginalize() {
   kept_blocks_.clear();
   kept_descriptions_.clear();
@@ -153,81 +232,13 @@ bool MarginalizationInfo::Marginalize() {
   r0_prior_.resize(0);
 
   // Tangent layout: marginalised blocks first, then kept ones, each in declaration order.
-  for (Block& b : blocks_) b.used = false;
-  for (const Residual& res : residuals_) {
-    for (double* p : res.parameter_blocks) blocks_[FindBlock(p)].used = true;
-  }
-  int n_marg = 0, n = 0;
-  for (Block& b : blocks_) {
-    if (b.used && b.role == Role::kMarginalize) {
-      b.offset = n;
-      n += b.tangent_size;
-    }
-  }
-  n_marg = n;
-  for (Block& b : blocks_) {
-    if (b.used && b.role == Role::kKeep) {
-      b.offset = n;
-      n += b.tangent_size;
-    }
-  }
+  int n = 0;
+  const int n_marg = LayOutTangents(&n);
   const int n_keep = n - n_marg;
-
   MatX H = MatX::Zero(n, n);
   VecX b_vec = VecX::Zero(n);
   for (const Residual& res : residuals_) {
-    const int m = res.cost->num_residuals();
-    const size_t num_blocks = res.parameter_blocks.size();
-    std::vector<int> index(num_blocks);
-    std::vector<RowMajorMat> J_amb(num_blocks);
-    std::vector<double*> jac_ptrs(num_blocks, nullptr);
-    for (size_t i = 0; i < num_blocks; ++i) {
-      index[i] = FindBlock(res.parameter_blocks[i]);
-      const Block& blk = blocks_[index[i]];
-      if (blk.role == Role::kConstant) continue;
-      J_amb[i].resize(m, blk.ambient_size);
-      jac_ptrs[i] = J_amb[i].data();
-    }
-    VecX r(m);
-    if (!res.cost->Evaluate(res.parameter_blocks.data(), r.data(), jac_ptrs.data())) return false;
-    if (!r.allFinite()) return false;
-    for (size_t i = 0; i < num_blocks; ++i) {
-      if (jac_ptrs[i] != nullptr && !J_amb[i].allFinite()) return false;
-    }
-
-    // Robust loss: rescale as Ceres's Corrector does, so that JᵀJ and Jᵀr are those the solver sees.
-    if (res.loss != nullptr) {
-      const double sq_norm = r.squaredNorm();
-      double rho[3];
-      res.loss->Evaluate(sq_norm, rho);
-      if (!(rho[1] > 0.0) || !std::isfinite(rho[1])) return false;
-      const double sqrt_rho1 = std::sqrt(rho[1]);
-      double residual_scaling = sqrt_rho1, alpha_sq_norm = 0.0;
-      if (sq_norm > 0.0 && rho[2] > 0.0) {
-        const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * sq_norm * rho[2] / rho[1]);
-        residual_scaling = sqrt_rho1 / (1.0 - alpha);
-        alpha_sq_norm = alpha / sq_norm;
-      }
-      for (size_t i = 0; i < num_blocks; ++i) {
-        if (jac_ptrs[i] == nullptr) continue;
-        const Eigen::RowVectorXd rT_J = r.transpose() * J_amb[i];
-        J_amb[i] = sqrt_rho1 * (J_amb[i] - alpha_sq_norm * r * rT_J);
-      }
-      r *= residual_scaling;
-    }
-
-    for (size_t i = 0; i < num_blocks; ++i) {
-      if (jac_ptrs[i] == nullptr) continue;
-      const Block& bi = blocks_[index[i]];
-      const MatX J_i = J_amb[i] * PlusJacobianAt(bi.kind, bi.ambient_size, bi.values);
-      b_vec.segment(bi.offset, bi.tangent_size) += J_i.transpose() * r;
-      for (size_t j = 0; j < num_blocks; ++j) {
-        if (jac_ptrs[j] == nullptr) continue;
-        const Block& bj = blocks_[index[j]];
-        const MatX J_j = J_amb[j] * PlusJacobianAt(bj.kind, bj.ambient_size, bj.values);
-        H.block(bi.offset, bj.offset, bi.tangent_size, bj.tangent_size) += J_i.transpose() * J_j;
-      }
-    }
+    if (!Accumulate(res, &H, &b_vec)) return false;
   }
 
   // Schur complement of the marginalised blocks, with a pseudo-inverse of H_mm: directions the residuals

@@ -117,6 +117,11 @@ class MarginalizationInfo {
     std::vector<double*> parameter_blocks;
   };
   int FindBlock(const double* values) const;
+  // Gives each used block its tangent column (marginalised first, then kept); returns the marginalised
+  // dimension and sets *n to the total.
+  int LayOutTangents(int* n);
+  // Adds one residual's JᵀJ and Jᵀr (tangent space, loss applied) to H and b; false if it fails to evaluate.
+  bool Accumulate(const Residual& res, MatX* H, VecX* b) const;
 
   Options options_;
   std::vector<Block> blocks_;

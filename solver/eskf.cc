@@ -19,26 +19,18 @@ using eskf::BlockOf;
 
 namespace {
 
-double GateFor(double probability, int dof) {
-  return probability > 0.0 ? Chi2Quantile(probability, dof) : std::numeric_limits<double>::infinity();
-}
-
-// Across an IMU gap the state coasts; these are the unknown acceleration and rotation rate held over it.
-constexpr double kGapAccSigma = 2.0;                // m/s²
-constexpr double kGapRateSigma = 10.0 * kDegToRad;  // rad/s
-constexpr size_t kMaxListed = 100;                  // gaps and resets listed in the summary
 constexpr double kZeroRateGateProbability = 0.9999;  // the gyro-reads-its-bias update at standstills
 
 }  // namespace
 
 Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state)
     : options_(options), on_state_(std::move(on_state)), watchdog_(options.watchdog) {
-  gate_gnss_ = GateFor(options_.gnss.gate_probability, 3);
-  gate_heading_ = GateFor(options_.gnss.gate_probability, 1);
-  gate_wheel_ = GateFor(options_.wheel.gate_probability, 1);
-  gate_nhc_ = GateFor(options_.wheel.gate_probability, 2);
-  gate_zupt_ = GateFor(options_.wheel.gate_probability, 3);
-  gate_zero_rate_ = GateFor(kZeroRateGateProbability, 3);
+  gate_gnss_ = Chi2Gate(options_.gnss.gate_probability, 3);
+  gate_heading_ = Chi2Gate(options_.gnss.gate_probability, 1);
+  gate_wheel_ = Chi2Gate(options_.wheel.gate_probability, 1);
+  gate_nhc_ = Chi2Gate(options_.wheel.gate_probability, 2);
+  gate_zupt_ = Chi2Gate(options_.wheel.gate_probability, 3);
+  gate_zero_rate_ = Chi2Gate(kZeroRateGateProbability, 3);
 }
 
 void Eskf::Initialize(const InitResult& init) {
@@ -106,8 +98,8 @@ void Eskf::PropagateCovariance(const ImuStepJacobians& J, double dt, bool gap) {
   Mat6 Qn = ImuDiscreteNoise(options_.imu.gyro_noise_density, options_.imu.acc_noise_density, dt);
   if (gap) {
     // An unknown rate and acceleration held over the step enter where the held sample does.
-    Qn.diagonal() += (Vec6() << Vec3::Constant(kGapRateSigma * kGapRateSigma),
-                      Vec3::Constant(kGapAccSigma * kGapAccSigma))
+    Qn.diagonal() += (Vec6() << Vec3::Constant(kImuGapRateSigma * kImuGapRateSigma),
+                      Vec3::Constant(kImuGapAccSigma * kImuGapAccSigma))
                          .finished();
   }
   const Eigen::Matrix<double, kA, 6> BQ = J.B.lazyProduct(Qn);
@@ -129,8 +121,7 @@ void Eskf::AddImu(const ImuSample& imu) {
   if (!initialized_) return;
   if (imu.t < x_.t) return;  // samples before the initialisation epoch were used by the initialiser
   if (last_imu_ && imu.t - last_imu_->t > options_.imu.max_gap) {
-    ++imu_gaps_;
-    if (gap_times_.size() < kMaxListed) gap_times_.emplace_back(last_imu_->t, imu.t);
+    imu_gaps_.Add(last_imu_->t, imu.t);
   }
   if (last_imu_) {
     const ImuSample mid = HeldBetween(*last_imu_, imu);
@@ -274,7 +265,7 @@ void Eskf::AddStandstill(const StandstillMeasurement& m) {
   gyro_sum_.setZero();
   gyro_count_ = 0;
   gyro_sum_start_ = m.t;
-  if (x_.v_w.norm() > options_.standstill.max_speed) {
+  if (!StandstillPlausible(x_.v_w, options_.standstill)) {
     zupt_counts_.Reject("moving", m.t);  // a quiet IMU at speed: not a stop
     return;
   }
@@ -299,18 +290,14 @@ bool Eskf::WatchGnss(const GnssMeasurement& m, bool accepted) {
 void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
   const bool finite = x_.AllFinite() && P_.allFinite();
   if (!finite) {
-    // Nothing is left to keep: attitude from the dual-antenna heading if there is one, level otherwise.
-    const double yaw = m.heading_valid ? m.yaw_G - options_.gnss.mount_yaw : 0.0;
-    x_.q_wb = QuatFromYaw(yaw);
+    x_.q_wb = FallbackAttitude(m, options_);
     x_.bg.setZero();
     x_.ba.setZero();
     x_.v_w.setZero();
     g_w_ = GravityWorld(g_w_.allFinite() ? g_w_.norm() : kStandardGravity);
     if (!std::isfinite(scale_)) scale_ = 1.0;
     P_.setZero();
-    BlockOf<Block::kTheta>(P_).diagonal() << 0.05, 0.05, 1.0;
-    BlockOf<Block::kBg>(P_).diagonal().setConstant(std::pow(options_.imu.init_gyro_bias_sigma, 2));
-    BlockOf<Block::kBa>(P_).diagonal().setConstant(std::pow(options_.imu.init_acc_bias_sigma, 2));
+    P_.topLeftCorner<nav::kDim, nav::kDim>() = FallbackCovariance(options_);
     if (options_.eskf.estimate_gravity) {
       BlockOf<Block::kG>(P_).diagonal().setConstant(std::pow(options_.eskf.gravity_sigma, 2));
     }
@@ -341,9 +328,7 @@ StateEstimate Eskf::Estimate() const {
 nlohmann::json Eskf::Stats() const {
   nlohmann::json j;
   j["imu_steps"] = imu_steps_;
-  j["imu_gaps"] = imu_gaps_;
-  j["imu_gap_times"] = nlohmann::json::array();
-  for (const auto& [a, b] : gap_times_) j["imu_gap_times"].push_back({a, b});
+  imu_gaps_.ToJson(&j);
   j["watchdog"] = watchdog_.ToJson();
   j["gnss_position"] = gnss_counts_.ToJson();
   j["gnss_heading"] = heading_counts_.ToJson();

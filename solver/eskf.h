@@ -91,8 +91,8 @@ class Eskf : public Estimator {
   // χ² gates, computed once (the quantile is an iterative inversion).
   double gate_gnss_ = 0.0, gate_heading_ = 0.0, gate_wheel_ = 0.0, gate_nhc_ = 0.0, gate_zupt_ = 0.0,
          gate_zero_rate_ = 0.0;
-  uint64_t imu_steps_ = 0, imu_gaps_ = 0;
-  std::vector<std::pair<double, double>> gap_times_;  // first few IMU gaps: [last sample, next sample]
+  uint64_t imu_steps_ = 0;
+  ImuGapLog imu_gaps_;
   MeasurementCounts gnss_counts_, heading_counts_, wheel_counts_, zupt_counts_;
 
   GnssWatchdog watchdog_;

@@ -1,6 +1,9 @@
 #include "solver/estimator.h"
 
 #include <algorithm>
+#include <cmath>
+
+#include "core/so3.h"
 
 namespace gins {
 
@@ -37,6 +40,29 @@ bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeas
   const double min_yaw_var = options.init.sigma_yaw * options.init.sigma_yaw;
   if (yaw_var < min_yaw_var) P.block<3, 3>(nav::kTheta, nav::kTheta) += (min_yaw_var - yaw_var) * z_b * z_b.transpose();
   return have_velocity;
+}
+
+Quat FallbackAttitude(const GnssMeasurement& m, const EstimatorOptions& options) {
+  return QuatFromYaw(m.heading_valid ? m.yaw_G - options.gnss.mount_yaw : 0.0);
+}
+
+Mat15 FallbackCovariance(const EstimatorOptions& options) {
+  Mat15 P = Mat15::Zero();
+  P.block<3, 3>(nav::kTheta, nav::kTheta).diagonal() << 0.05, 0.05, 1.0;
+  P.block<3, 3>(nav::kBg, nav::kBg).diagonal().setConstant(std::pow(options.imu.init_gyro_bias_sigma, 2));
+  P.block<3, 3>(nav::kBa, nav::kBa).diagonal().setConstant(std::pow(options.imu.init_acc_bias_sigma, 2));
+  return P;
+}
+
+void ImuGapLog::Add(double last_sample, double next_sample) {
+  ++count_;
+  if (times_.size() < kMaxListedTimes) times_.emplace_back(last_sample, next_sample);
+}
+
+void ImuGapLog::ToJson(nlohmann::json* j) const {
+  (*j)["imu_gaps"] = count_;
+  (*j)["imu_gap_times"] = nlohmann::json::array();
+  for (const auto& [a, b] : times_) (*j)["imu_gap_times"].push_back({a, b});
 }
 
 void MeasurementCounts::Reject(const std::string& reason, double t) {

@@ -62,6 +62,35 @@ class GnssWatchdog {
   uint64_t count_ = 0;
 };
 
+// IMU gaps longer than imu.max_gap_s, counted and the first few listed (summary: imu_gaps, imu_gap_times).
+class ImuGapLog {
+ public:
+  void Add(double last_sample, double next_sample);
+  void ToJson(nlohmann::json* j) const;
+
+ private:
+  uint64_t count_ = 0;
+  std::vector<std::pair<double, double>> times_;  // [last sample, next sample]
+};
+
+// Across an IMU gap longer than imu.max_gap_s both estimators coast (no rotation, no acceleration) with the
+// uncertainty of an unknown acceleration and rotation rate held over the gap.
+constexpr double kImuGapAccSigma = 2.0;                // m/s²
+constexpr double kImuGapRateSigma = 10.0 * kDegToRad;  // rad/s
+
+// A standstill detection is ignored while the estimate moves faster than standstill.max_speed_m_s: a quiet
+// IMU at constant speed is not a stop.
+inline bool StandstillPlausible(const Vec3& v_w, const StandstillOptions& options) {
+  return !(v_w.norm() > options.max_speed);
+}
+
+// When the state is no longer finite nothing is left to keep: a level attitude (the yaw of the dual-antenna
+// heading if the fix has one) and zero biases, with this covariance in NavState tangent order: attitude
+// 1-σ 0.22 rad in roll and pitch and 1 rad in yaw, biases at their initial σ (imu.init_*_bias_sigma);
+// position and velocity come from the fix (ResetPositionFromFix).
+Quat FallbackAttitude(const GnssMeasurement& m, const EstimatorOptions& options);
+Mat15 FallbackCovariance(const EstimatorOptions& options);
+
 // The watchdog's re-initialisation from a GNSS fix m, alike in both estimators: position from the fix
 // through the lever arm, velocity from the previous fix when it is recent (else kept), and both with a fresh
 // covariance, uncorrelated with the rest; the yaw variance is raised to at least init.sigma_yaw, since a

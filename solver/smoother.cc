@@ -16,10 +16,6 @@ namespace gins {
 namespace {
 
 constexpr double kSameEpoch = 1e-6;          // s: a fix at a keyframe's time belongs to it
-// IMU gap coasting, as in the ESKF.
-constexpr double kGapAccSigma = 2.0;                // m/s²
-constexpr double kGapRateSigma = 10.0 * kDegToRad;  // rad/s
-constexpr size_t kMaxListed = 100;
 
 double Seconds(std::chrono::steady_clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
@@ -83,7 +79,7 @@ void Smoother::IntegrateTo(double t, const ImuSample* held) {
       coast.gyro = pred_.bg;
       coast.acc = pred_.q_wb.conjugate() * -g_w_ + pred_.ba;
       held = &coast;
-      preint_->IntegrateGuess(coast.gyro, coast.acc, dt, kGapRateSigma, kGapAccSigma);
+      preint_->IntegrateGuess(coast.gyro, coast.acc, dt, kImuGapRateSigma, kImuGapAccSigma);
     } else {
       preint_->Integrate(*held, dt);
     }
@@ -101,8 +97,7 @@ void Smoother::IntegrateTo(double t, const ImuSample* held) {
 void Smoother::AddImu(const ImuSample& imu) {
   if (!initialized_ || imu.t < t_now_) return;
   if (last_imu_ && imu.t - last_imu_->t > options_.imu.max_gap) {
-    ++imu_gaps_;
-    if (gap_times_.size() < kMaxListed) gap_times_.emplace_back(last_imu_->t, imu.t);
+    imu_gaps_.Add(last_imu_->t, imu.t);
   }
   if (last_imu_) {
     const ImuSample mid = HeldBetween(*last_imu_, imu);
@@ -209,16 +204,10 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
     init.x0 = at_fix.AllFinite() ? at_fix : window_.front().State();
     initial_scale_ = window_.front().block(BlockType::kScale)[0];
   } else {
-    // Nothing is left to keep: attitude from the dual-antenna heading if there is one, level otherwise.
-    init.x0.q_wb = QuatFromYaw(m.heading_valid ? m.yaw_G - options_.gnss.mount_yaw : 0.0);
+    init.x0.q_wb = FallbackAttitude(m, options_);
     initial_scale_ = 1.0;
   }
-  if (!have_cov) {
-    cov.setZero();
-    cov.block<3, 3>(nav::kTheta, nav::kTheta).diagonal() << 0.05, 0.05, 1.0;
-    cov.block<3, 3>(nav::kBg, nav::kBg).diagonal().setConstant(std::pow(options_.imu.init_gyro_bias_sigma, 2));
-    cov.block<3, 3>(nav::kBa, nav::kBa).diagonal().setConstant(std::pow(options_.imu.init_acc_bias_sigma, 2));
-  }
+  if (!have_cov) cov = FallbackCovariance(options_);
   init.g_norm = g_w_.norm();
   const bool have_velocity = ResetPositionFromFix(m, prev_fix_, options_, &init.x0, cov);
   // Tiny floors keep the prior invertible whatever the window's covariance was.
@@ -358,9 +347,7 @@ nlohmann::json Smoother::Stats() const {
   j["gnss_decimated"] = gnss_decimated_;
   for (const auto& attacher : attachers_) attacher->AddStats(&j);
   j["final_odom_scale"] = last_scale_;
-  j["imu_gaps"] = imu_gaps_;
-  j["imu_gap_times"] = nlohmann::json::array();
-  for (const auto& [a, b] : gap_times_) j["imu_gap_times"].push_back({a, b});
+  imu_gaps_.ToJson(&j);
   j["watchdog"] = watchdog_.ToJson();
   return j;
 }

@@ -99,8 +99,7 @@ class Smoother : public Estimator {
   std::string reset_reason_;      // set by the checks, acted on at the end of AddGnss
   std::optional<GnssMeasurement> prev_fix_;
   double last_sigma_p_ = 0.0;     // largest position 1-σ of the last keyframe marginalised
-  uint64_t imu_gaps_ = 0;
-  std::vector<std::pair<double, double>> gap_times_;
+  ImuGapLog imu_gaps_;
 
   // Statistics.
   uint64_t solves_ = 0, iterations_ = 0, marginalizations_ = 0, keyframes_ = 0, reintegrations_ = 0;

@@ -22,10 +22,6 @@ constexpr double kStandstillPositionSigma = 1e-4;  // m
 constexpr double kStandstillReach = 0.15;          // s
 constexpr double kStandstillLossScale = 3.0;       // Cauchy loss scale on the whitened standstill residuals
 
-double Gate(double probability) {
-  return probability > 0.0 ? Chi2Quantile(probability, 3) : std::numeric_limits<double>::infinity();
-}
-
 // Squared norm of a 3-dimensional residual block's residual, without its loss.
 double SquaredResidual(ceres::Problem* problem, ceres::ResidualBlockId id) {
   double cost = 0.0;
@@ -41,7 +37,7 @@ double SquaredResidual(ceres::Problem* problem, ceres::ResidualBlockId id) {
 GnssAttacher::GnssAttacher(const EstimatorOptions& options, std::function<void(double, bool)> on_checked)
     : options_(options),
       on_checked_(std::move(on_checked)),
-      gate_(Gate(options.gnss.gate_probability)),
+      gate_(Chi2Gate(options.gnss.gate_probability, 3)),
       loss_(std::make_unique<ceres::CauchyLoss>(options.smoother.gnss_loss_scale)) {}
 
 bool GnssAttacher::OnGnss(const GnssMeasurement& m, const AttachContext& ctx) {
@@ -121,7 +117,7 @@ void WheelAttacher::AddStats(nlohmann::json* stats) const { (*stats)["wheel"] = 
 
 StandstillAttacher::StandstillAttacher(const EstimatorOptions& options)
     : options_(options),
-      gate_(Gate(options.wheel.gate_probability)),  // standstill.* has no gate of its own: the wheel's
+      gate_(Chi2Gate(options.wheel.gate_probability, 3)),  // standstill.* has no gate of its own: the wheel's
       loss_(std::make_unique<ceres::CauchyLoss>(kStandstillLossScale)) {}
 
 const StandstillAttacher::Record* StandstillAttacher::Find(uint64_t id) const {
@@ -139,7 +135,7 @@ void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
   if (!last_ || (existing != nullptr && existing->standstill) || &kf != &ctx.keyframes.back()) return;
   const StandstillMeasurement& s = *last_;
   if (kf.t < s.since || kf.t > s.t + kStandstillReach) return;
-  if (kf.State().v_w.norm() > options_.standstill.max_speed) {
+  if (!StandstillPlausible(kf.State().v_w, options_.standstill)) {
     counts_.Reject("moving", kf.t);  // a quiet IMU at speed: not a stop
     return;
   }

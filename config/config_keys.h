@@ -58,6 +58,9 @@ inline constexpr auto kGnssKeys = [](auto& v, GnssOptions& o) {
   v.Number("heading_sigma_deg", o.heading_sigma, kDeg, Positive());
   v.Boolean("use_heading", o.use_heading);
   v.Number("gate_probability", o.gate_probability, kNoUnit, GateProbability());
+  v.Boolean("use_velocity", o.use_velocity);
+  v.Vector3("velocity_sigma_m_s", o.velocity_sigma_enu, "[east, north, up]", Positive());
+  v.Number("min_velocity_sigma_m_s", o.min_velocity_sigma, kNoUnit, Positive());
   v.Origin("origin", o.origin);  // optional: null = the first usable fix
   v.Outages("outages_s", o.outages);
   v.PeriodicOutages("periodic_outages_s", o.periodic_outages);

@@ -36,6 +36,9 @@ struct GnssOptions {
   double heading_sigma = 0.5 * kDegToRad;   // gnss.heading_sigma_deg
   bool use_heading = true;                 // gnss.use_heading
   double gate_probability = 0.9999;        // gnss.gate_probability: χ² gate on the innovation (0 = off)
+  bool use_velocity = true;                // gnss.use_velocity: use GVEL records (Doppler velocity)
+  Vec3 velocity_sigma_enu = Vec3(0.1, 0.1, 0.2);  // gnss.velocity_sigma_m_s: for a GVEL record without σ
+  double min_velocity_sigma = 0.01;        // gnss.min_velocity_sigma_m_s: floor for a logged velocity σ
   std::optional<GeodeticPoint> origin;     // gnss.origin: [lat_deg, lon_deg, alt_m]; absent = first fix
   // Simulated GNSS outages (fixes in a window are dropped once initialised), times in s after the log's
   // first record; each window is [start, start + duration).

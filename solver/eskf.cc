@@ -6,6 +6,7 @@
 
 #include "core/chi2.h"
 #include "core/gnss_model.h"
+#include "core/gvel_model.h"
 #include "core/heading_model.h"
 #include "core/imu_kernel.h"
 #include "core/linearize.h"
@@ -208,6 +209,27 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
   }
 }
 
+void Eskf::AddGvel(const GvelMeasurement& m) {
+  if (!initialized_ || m.t < x_.t) return;
+  Propagate(m.t);
+  // The antenna's velocity includes the lever arm's turn: the body rate from the last IMU sample.
+  const Vec3 omega_b = last_imu_ ? Vec3(last_imu_->gyro - x_.bg) : Vec3::Zero();
+  Eigen::Matrix<double, 3, 1> r;
+  Eigen::Matrix<double, 3, 6> H6;  // (δv, δθ)
+  const NavState& x = x_;
+  Linearize<3, 6>(
+      [&](const auto& d) {
+        using T = typename std::decay_t<decltype(d)>::Scalar;
+        const Eigen::Matrix<T, 3, 1> v = x.v_w.cast<T>() + d.template head<3>();
+        const Eigen::Quaternion<T> q = x.q_wb.cast<T>() * ExpQuat<T>(d.template tail<3>());
+        return GnssVelocityModel::Residual<T>(q, v, omega_b, options_.gnss.lever_b, m.v_w);
+      },
+      &r, &H6);
+  const Mat3 R = m.sigma_w.cwiseAbs2().asDiagonal();
+  Update<3>(r, {{Block::kV, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}}, R, gate_gnss_, &gvel_counts_,
+            m.t);
+}
+
 void Eskf::AddWheel(const WheelMeasurement& m) {
   if (!initialized_ || m.t < x_.t || !options_.wheel.enabled) return;
   Propagate(m.t);
@@ -332,6 +354,7 @@ nlohmann::json Eskf::Stats() const {
   j["watchdog"] = watchdog_.ToJson();
   j["gnss_position"] = gnss_counts_.ToJson();
   j["gnss_heading"] = heading_counts_.ToJson();
+  j["gnss_velocity"] = gvel_counts_.ToJson();
   j["wheel"] = wheel_counts_.ToJson();
   j["zero_velocity"] = zupt_counts_.ToJson();
   j["final_odom_scale"] = scale_;

@@ -45,6 +45,7 @@ class Eskf : public Estimator {
   void Initialize(const InitResult& init) override;
   void AddImu(const ImuSample& imu) override;
   void AddGnss(const GnssMeasurement& gnss) override;
+  void AddGvel(const GvelMeasurement& gvel) override;
   void AddWheel(const WheelMeasurement& wheel) override;
   void AddStandstill(const StandstillMeasurement& m) override;
   void Finish() override {}
@@ -93,7 +94,7 @@ class Eskf : public Estimator {
          gate_zero_rate_ = 0.0;
   uint64_t imu_steps_ = 0;
   ImuGapLog imu_gaps_;
-  MeasurementCounts gnss_counts_, heading_counts_, wheel_counts_, zupt_counts_;
+  MeasurementCounts gnss_counts_, heading_counts_, gvel_counts_, wheel_counts_, zupt_counts_;
 
   GnssWatchdog watchdog_;
   std::optional<GnssMeasurement> prev_fix_;  // the fix before the current one, accepted or not

@@ -103,6 +103,9 @@ void FeedLog(const RunOptions& options, const RunRequest& request, LogReader* re
       case LogRecord::Type::kGnss:
         session->AddGnss(rec.gnss);
         break;
+      case LogRecord::Type::kGvel:
+        session->AddGvel(rec.gvel);
+        break;
     }
     if (!session->initialized() && session->elapsed() > options.init.max_wait) {
       throw RunError(request.log_path + ": not initialised after " + std::to_string(options.init.max_wait) +
@@ -117,7 +120,9 @@ void CheckInput(const std::string& log_path, const ReadStats& rs, const Session&
     if (rs.lines == 0) return RunError(log_path + ": empty log (no lines)");
     std::string m = log_path + ": no usable " + what + " records (" + std::to_string(rs.lines) + " lines: " +
                     std::to_string(rs.imu) + " IMU, " + std::to_string(rs.odom) + " ODOM, " +
-                    std::to_string(rs.gnss) + " GNSS, " + std::to_string(rs.total_skipped()) + " damaged";
+                    std::to_string(rs.gnss) + " GNSS, " +
+                    (rs.gvel > 0 ? std::to_string(rs.gvel) + " GVEL, " : std::string()) +
+                    std::to_string(rs.total_skipped()) + " damaged";
     if (!rs.examples.empty()) {
       m += "; first: line " + std::to_string(rs.examples.front().line) + ": " + rs.examples.front().reason + ": " +
            rs.examples.front().detail;
@@ -133,7 +138,7 @@ void CheckInput(const std::string& log_path, const ReadStats& rs, const Session&
 nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nlohmann::json& session_stats) {
   nlohmann::json input;
   input["lines"] = rs.lines;
-  input["records"] = {{"imu", rs.imu}, {"odom", rs.odom}, {"gnss", rs.gnss}};
+  input["records"] = {{"imu", rs.imu}, {"odom", rs.odom}, {"gnss", rs.gnss}, {"gvel", rs.gvel}};
   input["skipped"] = nlohmann::json::object();
   for (const auto& [k, v] : rs.skipped) input["skipped"][k] = v;
   input["skipped_examples"] = nlohmann::json::array();
@@ -146,6 +151,7 @@ nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nloh
   input["first_time"] = session.first_time();
   input["last_time"] = session.last_time();
   input["odom_ignored_wheel_disabled"] = session_stats["odom_ignored_wheel_disabled"];
+  input["gvel_unused"] = session_stats["gvel_unused"];
   input["dropped_before_first_fix"] = session_stats["dropped_before_first_fix"];
   return input;
 }

@@ -119,6 +119,7 @@ void Session::AddGnss(const GnssRecord& g) {
   if (DropForSimulatedOutage(g.t)) return;
   if (!frame_) frame_.emplace(GeodeticPoint{g.lat_deg, g.lon_deg, g.alt_m});
   EnsureInitializer();
+  last_fix_geo_ = GeodeticPoint{g.lat_deg, g.lon_deg, g.alt_m};
   GnssMeasurement m;
   m.t = g.t;
   m.p_w = frame_->ToEnu({g.lat_deg, g.lon_deg, g.alt_m});
@@ -136,6 +137,20 @@ void Session::AddGnss(const GnssRecord& g) {
   } else {
     Dispatch([&](Estimator& e) { e.AddGnss(m); });
   }
+}
+
+void Session::AddGvel(const GvelRecord& g) {
+  Touch(g.t);
+  const bool in_outage = initialized_ && !outage_schedule_.empty() && outage_schedule_.Contains(g.t, first_t_);
+  if (!options_.gnss.use_velocity || !last_fix_geo_ || !initialized_ || in_outage) {
+    ++gvel_unused_;
+    return;
+  }
+  GvelMeasurement m;
+  m.t = g.t;
+  m.v_w = frame_->RotationFromLocalEnu(*last_fix_geo_) * g.v_enu;
+  m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options_.gnss.min_velocity_sigma) : options_.gnss.velocity_sigma_enu;
+  Dispatch([&](Estimator& e) { e.AddGvel(m); });
 }
 
 // --- Simulated GNSS outages ---------------------------------------------------------------------------------
@@ -164,6 +179,7 @@ void Session::Finish() {
 nlohmann::json Session::Stats() const {
   nlohmann::json j;
   j["odom_ignored_wheel_disabled"] = odom_ignored_;
+  j["gvel_unused"] = gvel_unused_;
   j["dropped_before_first_fix"] = pending_dropped_;
   j["standstill_updates"] = standstill_sent_;
   // Simulated outages as absolute [begin, end) windows, and the log's own GNSS gaps.

@@ -38,6 +38,7 @@ class Session {
   void AddImu(const ImuSample& raw);
   void AddOdom(const OdomRecord& odom);
   void AddGnss(const GnssRecord& fix);
+  void AddGvel(const GvelRecord& vel);
   // End of the data: flushes the estimators. Throws RunError if initialisation never completed.
   void Finish();
 
@@ -74,6 +75,10 @@ class Session {
   std::vector<ImuSample> pending_imu_;
   std::vector<WheelMeasurement> pending_wheel_;
   uint64_t pending_dropped_ = 0, odom_ignored_ = 0;
+  // GNSS velocities: the local frame of the last fix turns them into w (it differs from w by distance /
+  // Earth radius); those before the first fix or during initialisation, or disabled, are counted.
+  std::optional<GeodeticPoint> last_fix_geo_;
+  uint64_t gvel_unused_ = 0;
   double first_t_ = -1.0, last_t_ = 0.0;
 
   // Standstill detection (core/standstill_detector.h), fed from the initialiser's start; after

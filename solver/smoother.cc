@@ -32,6 +32,7 @@ Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, Stat
   // looks as quiet as a stop) goes first: with it in, the fix that contradicts it would be the one to fail.
   attachers_.push_back(std::make_unique<WheelAttacher>(options_));
   attachers_.push_back(std::make_unique<StandstillAttacher>(options_));
+  attachers_.push_back(std::make_unique<GvelAttacher>(options_));
   attachers_.push_back(
       std::make_unique<GnssAttacher>(options_, [this](double t, bool accepted) { WatchGnss(t, accepted); }));
 }
@@ -142,6 +143,11 @@ Keyframe& Smoother::CreateKeyframe(double t) {
 void Smoother::AddStandstill(const StandstillMeasurement& m) {
   if (!initialized_) return;
   for (auto& attacher : attachers_) attacher->OnStandstill(m, context_);
+}
+
+void Smoother::AddGvel(const GvelMeasurement& m) {
+  if (!initialized_) return;
+  for (auto& attacher : attachers_) attacher->OnGvel(m, context_);
 }
 
 void Smoother::AddWheel(const WheelMeasurement& w) {

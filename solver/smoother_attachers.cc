@@ -7,6 +7,7 @@
 
 #include "core/chi2.h"
 #include "factors/gnss_factor.h"
+#include "factors/gvel_factor.h"
 #include "factors/heading_factor.h"
 #include "factors/nhc_factor.h"
 #include "factors/wheel_factor.h"
@@ -21,6 +22,7 @@ namespace {
 constexpr double kStandstillPositionSigma = 1e-4;  // m
 constexpr double kStandstillReach = 0.15;          // s
 constexpr double kStandstillLossScale = 3.0;       // Cauchy loss scale on the whitened standstill residuals
+constexpr double kSameEpoch = 1e-6;                // s: a measurement at a keyframe's time belongs to it
 
 // Squared norm of a 3-dimensional residual block's residual, without its loss.
 double SquaredResidual(ceres::Problem* problem, ceres::ResidualBlockId id) {
@@ -31,6 +33,21 @@ double SquaredResidual(ceres::Problem* problem, ceres::ResidualBlockId id) {
 }
 
 }  // namespace
+
+// --- GNSS velocity -------------------------------------------------------------------------------------------
+
+void GvelAttacher::OnGvel(const GvelMeasurement& m, const AttachContext& ctx) {
+  Keyframe& kf = ctx.keyframes.back();
+  if (std::abs(m.t - kf.t) > kSameEpoch) {
+    counts_.Reject("no_keyframe", m.t);
+    return;
+  }
+  const NavState x = kf.State();
+  const Vec3 omega_b = ctx.last_imu ? Vec3(ctx.last_imu->gyro - x.bg) : Vec3::Zero();
+  ctx.keyframes.AddFactor(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, options_.gnss.lever_b), nullptr,
+                          {{&kf, BlockType::kPose}, {&kf, BlockType::kVelocity}});
+  ++counts_.used;
+}
 
 // --- GNSS -------------------------------------------------------------------------------------------------
 

@@ -46,6 +46,7 @@ class MeasurementAttacher {
   virtual bool OnGnss(const GnssMeasurement& /*m*/, const AttachContext& /*ctx*/) { return false; }
   virtual void OnWheel(const WheelMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
   virtual void OnStandstill(const StandstillMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
+  virtual void OnGvel(const GvelMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
   // A keyframe became the newest, with its IMU and random-walk factors.
   virtual void OnKeyframeCreated(Keyframe& /*kf*/, const AttachContext& /*ctx*/) {}
   // After a solve, in attacher order: the checks of what was attached. True if the problem changed, so
@@ -101,6 +102,19 @@ class WheelAttacher final : public MeasurementAttacher {
   // The keyframe with the wheel factor, if any. Factors go to the newest keyframe only, so one id is all
   // the memory needed.
   std::optional<uint64_t> attached_to_;
+  MeasurementCounts counts_;
+};
+
+// GNSS velocity on the keyframe of its epoch (made for the fix of that epoch); without one it is not used
+// (counted: no_keyframe).
+class GvelAttacher final : public MeasurementAttacher {
+ public:
+  explicit GvelAttacher(const EstimatorOptions& options) : options_(options) {}
+  void OnGvel(const GvelMeasurement& m, const AttachContext& ctx) override;
+  void AddStats(nlohmann::json* stats) const override { (*stats)["gnss_velocity"] = counts_.ToJson(); }
+
+ private:
+  EstimatorOptions options_;
   MeasurementCounts counts_;
 };
 

@@ -34,6 +34,7 @@ constexpr const char* kImuFields[] = {"t", "gx", "gy", "gz", "ax", "ay", "az"};
 constexpr const char* kOdomFields[] = {"t", "left_pulses", "right_pulses"};
 constexpr const char* kGnssFields[] = {"t",       "lat",     "lon",    "alt", "heading", "heading_valid",
                                        "sigma_e", "sigma_n", "sigma_u"};
+constexpr const char* kGvelFields[] = {"t", "ve", "vn", "vu", "sigma_e", "sigma_n", "sigma_u"};
 constexpr size_t kMaxNumbers = 9;               // GNSS with σ
 constexpr size_t kMaxTokens = kMaxNumbers + 1;  // plus the type
 
@@ -126,6 +127,20 @@ std::string CheckGnss(const double* v, size_t n) {
   return {};
 }
 
+std::string CheckGvel(const double* v, size_t n) {
+  for (size_t i = 1; i <= 3; ++i) {
+    if (!(std::abs(v[i]) <= log_limits::kMaxAbsSpeed)) {
+      return FieldValue(i, kGvelFields[i], v[i]) + " m/s, beyond ±" + Num(log_limits::kMaxAbsSpeed);
+    }
+  }
+  for (size_t i = 4; i < n; ++i) {
+    if (!(v[i] > 0.0 && v[i] < log_limits::kMaxAbsSpeed)) {
+      return FieldValue(i, kGvelFields[i], v[i]) + " m/s, σ must be in (0, " + Num(log_limits::kMaxAbsSpeed) + ")";
+    }
+  }
+  return {};
+}
+
 // Heading in [-360, 360] -> [0, 360).
 double NormaliseHeading(double h) {
   h = std::fmod(h, 360.0);
@@ -150,6 +165,10 @@ bool ClassifyType(const Tokens& tokens, LogRecord* record, const char* const** n
     record->type = LogRecord::Type::kGnss;
     *names = kGnssFields;
     *expected = tokens.count - 1 >= 9 ? 9 : 6;
+  } else if (type == "GVEL") {
+    record->type = LogRecord::Type::kGvel;
+    *names = kGvelFields;
+    *expected = tokens.count - 1 >= 7 ? 7 : 4;
   } else {
     return false;
   }
@@ -159,17 +178,22 @@ bool ClassifyType(const Tokens& tokens, LogRecord* record, const char* const** n
 // Field counts are of the values after the type; the message lists what the type needs.
 LineParse CheckFieldCount(LogRecord::Type type, const char* const* names, size_t n, size_t expected,
                           InputIssue* issue) {
-  const bool gnss = type == LogRecord::Type::kGnss;
-  if (gnss && (n == 7 || n == 8)) {
-    return Damaged(
-        issue, kMissingFields,
-        "GNSS has " + std::to_string(n) + " values; sigma_e sigma_n sigma_u come all three or none");
+  // GNSS and GVEL take their three σ columns all or none.
+  const bool gnss = type == LogRecord::Type::kGnss, gvel = type == LogRecord::Type::kGvel;
+  const size_t with_sigma = gnss ? 9 : 7;
+  if ((gnss || gvel) && n > with_sigma - 3 && n < with_sigma) {
+    return Damaged(issue, kMissingFields,
+                   std::string(LogRecordTypeName(type)) + " has " + std::to_string(n) +
+                       " values; sigma_e sigma_n sigma_u come all three or none");
   }
   if (n != expected) {
-    std::string detail = std::string(LogRecordTypeName(type)) + " has " + std::to_string(n) +
-                         " values, needs " + (gnss ? "6 or 9" : std::to_string(expected)) + ":";
-    for (size_t i = 0; i < (gnss ? 9 : expected); ++i) detail += std::string(" ") + names[i];
-    if (gnss) detail += " (sigma optional)";
+    const bool optional = gnss || gvel;
+    std::string detail = std::string(LogRecordTypeName(type)) + " has " + std::to_string(n) + " values, needs " +
+                         (optional ? std::to_string(with_sigma - 3) + " or " + std::to_string(with_sigma)
+                                   : std::to_string(expected)) +
+                         ":";
+    for (size_t i = 0; i < (optional ? with_sigma : expected); ++i) detail += std::string(" ") + names[i];
+    if (optional) detail += " (sigma optional)";
     return Damaged(issue, n < expected ? kMissingFields : kExtraFields, std::move(detail));
   }
   return LineParse::kRecord;
@@ -197,6 +221,9 @@ LineParse ParseValues(const Tokens& tokens, LogRecord::Type type, const char* co
       break;
     case LogRecord::Type::kGnss:
       absurd = CheckGnss(v, n);
+      break;
+    case LogRecord::Type::kGvel:
+      absurd = CheckGvel(v, n);
       break;
   }
   if (!absurd.empty()) return Damaged(issue, kAbsurdValue, std::move(absurd));
@@ -227,6 +254,14 @@ void FillRecord(const double* v, size_t n, LogRecord* record) {
       g.sigma_enu = g.has_sigma ? Vec3(v[6], v[7], v[8]) : Vec3::Zero();
       break;
     }
+    case LogRecord::Type::kGvel: {
+      GvelRecord& g = record->gvel;
+      g.t = v[0];
+      g.v_enu = Vec3(v[1], v[2], v[3]);
+      g.has_sigma = n == 7;
+      g.sigma_enu = g.has_sigma ? Vec3(v[4], v[5], v[6]) : Vec3::Zero();
+      break;
+    }
   }
 }
 
@@ -240,6 +275,8 @@ double LogRecord::t() const {
       return odom.t;
     case Type::kGnss:
       return gnss.t;
+    case Type::kGvel:
+      return gvel.t;
   }
   return imu.t;
 }
@@ -252,6 +289,8 @@ const char* LogRecordTypeName(LogRecord::Type type) {
       return "ODOM";
     case LogRecord::Type::kGnss:
       return "GNSS";
+    case LogRecord::Type::kGvel:
+      return "GVEL";
   }
   return "?";
 }
@@ -268,7 +307,7 @@ LineParse ParseLogLine(std::string_view line, LogRecord* record, InputIssue* iss
   size_t expected = 0;
   if (!ClassifyType(tokens, record, &names, &expected)) {
     return Damaged(issue, kUnknownType,
-                   "unknown record type " + QuoteToken(tokens.tok[0]) + " (expected IMU, ODOM or GNSS)");
+                   "unknown record type " + QuoteToken(tokens.tok[0]) + " (expected IMU, ODOM, GNSS or GVEL)");
   }
   const size_t n = tokens.count - 1;
   if (CheckFieldCount(record->type, names, n, expected, issue) == LineParse::kDamaged) {

@@ -63,8 +63,8 @@ class LogReader::Impl {
   // Time order: the newest accepted time, and the last accepted time per record type.
   bool have_newest_ = false;
   double newest_t_ = 0.0;
-  std::array<bool, 3> have_last_{};
-  std::array<double, 3> last_t_{};
+  std::array<bool, LogRecord::kNumTypes> have_last_{};
+  std::array<double, LogRecord::kNumTypes> last_t_{};
   // Consecutive time_jump records that agree with each other (a real jump of the log's clock).
   int jump_run_ = 0;
   double jump_last_t_ = 0.0;
@@ -160,6 +160,9 @@ void LogReader::Impl::Accept(LogRecord* record, uint64_t line) {
       break;
     case LogRecord::Type::kGnss:
       ++stats_->gnss;
+      break;
+    case LogRecord::Type::kGvel:
+      ++stats_->gvel;
       break;
   }
 }

@@ -53,15 +53,18 @@ inline constexpr double kMaxAlt = 1e5;              // m, exclusive
 inline constexpr double kMaxSigma = 1e4;            // m, exclusive; σ must also be > 0 (a zero σ breaks a solver)
 inline constexpr double kMaxAbsHeadingDeg = 360.0;  // inclusive; normalised into [0, 360)
 inline constexpr double kMaxAbsPulses = 1e7;        // exclusive
+inline constexpr double kMaxAbsSpeed = 1000.0;      // m/s, per axis of a GNSS velocity, inclusive
 }  // namespace log_limits
 
 struct LogRecord {
-  enum class Type { kImu, kOdom, kGnss };
+  enum class Type { kImu, kOdom, kGnss, kGvel };
+  static constexpr int kNumTypes = 4;
   Type type = Type::kImu;
   uint64_t line = 0;  // 1-based line number in the file
   ImuSample imu;      // valid when type == kImu
   OdomRecord odom;    // valid when type == kOdom
   GnssRecord gnss;    // valid when type == kGnss
+  GvelRecord gvel;    // valid when type == kGvel
   double t() const;
 };
 
@@ -76,7 +79,7 @@ struct InputIssue {
 
 struct ReadStats {
   uint64_t lines = 0;
-  uint64_t imu = 0, odom = 0, gnss = 0;    // records accepted
+  uint64_t imu = 0, odom = 0, gnss = 0, gvel = 0;  // records accepted
   std::map<std::string, uint64_t> skipped;  // reason -> count
   std::vector<InputIssue> examples;        // up to kMaxExamplesPerReason per reason
   // Every damaged line's number, by reason (at most input.max_errors + 1 in all: then the read stops).

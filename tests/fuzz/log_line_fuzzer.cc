@@ -37,6 +37,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         case gins::LogRecord::Type::kOdom:
           Require(std::isfinite(record.odom.left_pulses) && std::isfinite(record.odom.right_pulses));
           break;
+        case gins::LogRecord::Type::kGvel:
+          Require(record.gvel.v_enu.allFinite() && record.gvel.v_enu.cwiseAbs().maxCoeff() <= 1000.0);
+          Require(!record.gvel.has_sigma || (record.gvel.sigma_enu.minCoeff() > 0.0 && record.gvel.sigma_enu.allFinite()));
+          break;
         case gins::LogRecord::Type::kGnss: {
           const gins::GnssRecord& g = record.gnss;
           Require(std::abs(g.lat_deg) <= 90.0 && std::abs(g.lon_deg) <= 180.0 && std::isfinite(g.alt_m));

@@ -97,6 +97,19 @@ TEST_F(LogReaderTest, ReadsAllTypesWithValuesAndLineNumbers) {
   EXPECT_TRUE(r.stats.examples.empty());
 }
 
+TEST_F(LogReaderTest, GnssVelocityWithAndWithoutSigma) {
+  const ReadResult r = ReadAll(Write("log.txt", Imu("1.0") + "\nGVEL 1.0 3.5 -1.25 0.5\nGVEL 2.0 1 2 3 0.1 0.2 0.3\n"));
+  ASSERT_EQ(r.records.size(), 3u);
+  EXPECT_EQ(r.stats.gvel, 2u);
+  ASSERT_EQ(r.records[1].type, LogRecord::Type::kGvel);
+  EXPECT_EQ(r.records[1].gvel.t, 1.0);
+  EXPECT_EQ(r.records[1].gvel.v_enu, Vec3(3.5, -1.25, 0.5));
+  EXPECT_FALSE(r.records[1].gvel.has_sigma);
+  EXPECT_TRUE(r.records[2].gvel.has_sigma);
+  EXPECT_EQ(r.records[2].gvel.sigma_enu, Vec3(0.1, 0.2, 0.3));
+  EXPECT_EQ(r.records[2].line, 3u);
+}
+
 TEST_F(LogReaderTest, CommentsBlankLinesCrlfTabsAndWhitespace) {
   const std::string path = Write("log.txt",
                                  "# gins log\r\n"
@@ -288,6 +301,13 @@ std::vector<DamageCase> DamageCases() {
       {"GNSS 1.5 31.5 120.4 10.5 170.9 1 0 0.1 0.1", "absurd_value"},
       {"GNSS 1.5 31.5 120.4 10.5 170.9 1 0.1 -0.1 0.1", "absurd_value"},
       {"GNSS 1.5 31.5 120.4 10.5 170.9 1 0.1 0.1 1e4", "absurd_value"},
+      {"GVEL 1.5 1 2", "missing_fields"},
+      {"GVEL 1.5 1 2 3 0.1", "missing_fields"},
+      {"GVEL 1.5 1 2 3 0.1 0.1 0.1 0.1", "extra_fields"},
+      {"GVEL 1.5 1 2 x", "bad_number"},
+      {"GVEL 1.5 1 2 nan", "non_finite"},
+      {"GVEL 1.5 1001 2 3", "absurd_value"},
+      {"GVEL 1.5 1 2 3 0.1 0 0.1", "absurd_value"},
       {Imu("0.5"), "out_of_order"},
       {"ODOM 0.999 1 1", "out_of_order"},
       {"GNSS 0.5 31.5 120.4 10.5 170.9 1", "out_of_order"},

@@ -136,6 +136,7 @@ inline constexpr auto kSegmentKeys = [](auto& v, SimSegment& s) {
   v.Number("accel_m_s2", s.accel, kNoUnit, Within(-10.0, 10.0));
   v.Number("yaw_rate_deg_s", s.yaw_rate, kDeg, Within(-90.0, 90.0));
   v.Number("grade_deg", s.grade, kDeg, Within(-45.0, 45.0));
+  v.Boolean("reverse", s.reverse);
 };
 
 inline constexpr auto kSimulateKeys = [](auto& v, SimOptions& o) {
@@ -169,6 +170,10 @@ inline constexpr auto kSimulateKeys = [](auto& v, SimOptions& o) {
   v.Number("wheel_scale", o.wheel_scale, kNoUnit, Within(0.5, 1.5));
   v.Number("wheel_speed_noise_m_s", o.wheel_speed_noise, kNoUnit, NonNegative());
   v.Number("track_width_m", o.track_width, kNoUnit, Positive());
+  v.Boolean("earth_rotation", o.earth_rotation);
+  v.Vector3("gnss_velocity_sigma_m_s", o.gnss_velocity_sigma, "[east, north, up]", NonNegative());
+  v.Number("gnss_noise_correlation_s", o.gnss_noise_correlation, kNoUnit, NonNegative());
+  v.Number("log_start_s", o.log_start, kNoUnit, NonNegative());
 };
 
 // The sections of a config file, in file order.

@@ -1,40 +1,63 @@
 // Seeded, reproducible vehicle simulator: `gins simulate` writes its output to files (Simulate), and the
 // end-to-end tests run the same drive in memory (Simulator).
 //
-// World: flat Earth in the local ENU frame w at sim.origin. No Earth rotation and no curvature inside the
-// simulation: gravity is g_w = (0, 0, −NormalGravity(origin)) everywhere, as gins assumes. Geodetic
-// output (GNSS fixes, truth.csv) maps w through LocalEnuFrame(origin), the same map gins uses to read it.
+// World: the local ENU frame w at sim.origin, fixed to the Earth (DESIGN §2). The vehicle drives in w (its
+// roads are the tangent plane at the origin tilted by the grades, so far from the origin they climb by
+// d²/2R: 2 m at 5 km); geodetic output (GNSS fixes, truth.csv) maps w through LocalEnuFrame(origin), the same
+// map gins uses to read it. Two Earth models (sim.earth_rotation):
+//   flat (false): no Earth rotation, gravity g_w = (0, 0, −NormalGravity(origin)) everywhere, as the flat
+//     estimators assume; attitudes, velocities and headings are written as they are in w;
+//   rotating (true): w turns with the Earth at ω_ie^w = Ω(0, cos φ0, sin φ0) (core/earth.h), gravity is the
+//     exact WGS84 normal gravity with its centrifugal part at the vehicle's position, g_w(p_wb)
+//     (NormalGravityWorld: the plumb line leans by distance / R away from the origin), and what a receiver
+//     or a truth file gives in the local ENU frame l at its point (truth attitude and velocity, heading from
+//     true north, GNSS velocity) is rotated there by R_w_l(p)ᵀ = LocalEnuFrame::RotationFromLocalEnu(p)ᵀ.
 //
 // Vehicle: body b = IMU frame FLU, R_wb = Rz(yaw)·Ry(−pitch) (roll zero, pitch = road grade, nose up
-// positive), no side slip: v_w = speed·R_wb·e_x, p_wb(0) = 0, yaw(0) = sim.initial_yaw, at rest at t = 0.
-// Each segment commands a forward acceleration and a yaw rate, reached from the previous segment's values
-// (zero before the first) by a cosine ramp over the first min(1 s, duration) of the segment, and a grade,
-// reached by a cosine ramp over the whole segment. ω_b and a_w are therefore continuous, with one
-// exception: the speed never goes negative. When it reaches zero under a negative acceleration the vehicle
-// stops (a_w drops to zero, as when a car comes to rest) and stays stopped until the commanded
-// acceleration turns positive. The yaw rate is applied as given, also at standstill (turning in place).
+// positive), no side slip: v_w = ±speed·R_wb·e_x (− in a reverse segment: the body faces forward while the
+// vehicle backs up), p_wb(0) = 0, yaw(0) = sim.initial_yaw, at rest at t = 0.
+// Each segment commands an acceleration of the speed (forward in a forward segment, backwards in reverse)
+// and a yaw rate, reached from the previous segment's values (zero before the first) by a cosine ramp over
+// the first min(1 s, duration) of the segment, and a grade, reached by a cosine ramp over the whole
+// segment. ω_b and a_w are therefore continuous, with one exception: the speed never goes negative. When it
+// reaches zero under a negative acceleration the vehicle stops (a_w drops to zero, as when a car comes to
+// rest) and stays stopped until the commanded acceleration turns positive. The yaw rate is applied as
+// given, also at standstill (turning in place). The gear changes only at a standstill: a segment whose
+// `reverse` differs from the previous segment's must start with the vehicle stopped.
 // Yaw, pitch and speed are closed-form; the position integrates the velocity by Gauss–Legendre quadrature
 // between knots placed at every break of smoothness, so the truth is exact to round-off and independent
 // of gins's first-order IMU kernel.
 //
 // Sensors (DESIGN §2 IMU model, §3 log format). Time stamps are start_time + k/rate, k = 0, 1, ... (wheel
-// from k = 1: pulses count over (t − Δt, t]); records in time order, ties IMU, ODOM, GNSS.
-//   IMU   ω̃ = ω_b + bg + ηg,  ã = R_wbᵀ(a_w − g_w) + ba + ηa, sampled at the time stamp; η white with
-//         σ = density·√rate; biases = turn-on N(0, σ) per axis + random walk (σ_rw·√dt per sample).
-//   GNSS  antenna p_wb + R_wb·lever_b + N(0, σ_enu); heading = compass(yaw(R_wb·Rz(mount_yaw)) +
-//         N(0, σ_heading)), flagged invalid (and written as 0) with probability heading_invalid_fraction;
-//         no fix in [start, start + duration) of an outage (elapsed seconds); with probability
-//         gnss_outlier_probability a fix is moved by gnss_outlier_magnitude in a uniform horizontal
-//         direction. σ columns = sim.gnss_sigma_enu when write_gnss_sigma.
-//   ODOM  wheel speeds v ∓ ω_b.z·track/2 (left, right), measured as wheel_scale·v + N(0, wheel_speed_noise)
-//         averaged over the interval, counted as pulses = distance·pulses_per_rev/(2π·wheel_radius),
-//         rounded to whole pulses with the remainder carried to the next interval (as an encoder counts).
-//         No noise while the vehicle neither rolls nor turns: parked, the encoders count zero.
+// from k = 1: pulses count over (t − Δt, t]); records in time order, ties IMU, ODOM, GNSS, GVEL.
+//   IMU   flat:     ω̃ = ω_b + bg + ηg,              ã = R_wbᵀ(a_w − g_w) + ba + ηa;
+//         rotating: ω̃ = ω_b + R_wbᵀω_ie^w + bg + ηg, ã = R_wbᵀ(a_w + 2ω_ie^w×v_w − g_w(p_wb)) + ba + ηa;
+//         sampled at the time stamp; η white with σ = density·√rate; biases = turn-on N(0, σ) per axis +
+//         random walk (σ_rw·√dt per sample).
+//   GNSS  antenna p_wb + R_wb·lever_b + e_k; e_k per axis white N(0, σ_enu), or with
+//         gnss_noise_correlation τ > 0 first-order Gauss–Markov: e_k = ρ·e_{k−1} + √(1−ρ²)·σ·n_k,
+//         ρ = exp(−Δt/τ), Δt = 1/gnss_rate, e_0 = σ·n_0 (stationary), running through outages.
+//         Heading = compass(yaw(R_wb·Rz(mount_yaw)) + N(0, σ_heading)), the yaw taken in w (flat) or in the
+//         local ENU frame at the antenna (rotating: from true north there); flagged invalid (and written
+//         as 0) with probability heading_invalid_fraction; no fix in [start, start + duration) of an outage
+//         (elapsed seconds); with probability gnss_outlier_probability a fix is moved by
+//         gnss_outlier_magnitude in a uniform horizontal direction. σ columns = sim.gnss_sigma_enu when
+//         write_gnss_sigma.
+//   GVEL  when any gnss_velocity_sigma > 0, with every fix: the antenna velocity v_w + R_wb·(ω_b × lever_b)
+//         (in the local ENU frame at the antenna when rotating) + N(0, σ) per axis, σ columns always written.
+//   ODOM  wheel speeds v ∓ ω_b.z·track/2 (left, right; v < 0 in reverse), measured as wheel_scale·v +
+//         N(0, wheel_speed_noise) averaged over the interval, counted as pulses = distance·pulses_per_rev /
+//         (2π·wheel_radius), rounded to whole (signed) pulses with the remainder carried to the next interval
+//         (as an encoder counts). No noise while the vehicle neither rolls nor turns: parked, the encoders
+//         count zero.
 //   A rate of 0 turns GNSS or the wheels off.
+// log_start: the drive is simulated from start_time, but records (and truth rows) before start_time +
+// log_start are not returned, nor an encoder interval that straddles it: the log of a vehicle already on
+// its way. The records that remain are those of the whole drive, bit for bit.
 // Randomness: one std::mt19937_64 per random source (IMU bias, IMU noise, GNSS position, heading, heading
-// validity, outliers, wheels), each seeded from a master mt19937_64(sim.seed), and a fixed number of draws
-// per sample whatever the options; so changing one sensor's settings leaves the other draws unchanged.
-// Normals are drawn by Box–Muller from the engine's raw bits, so the streams do not depend on the
+// validity, outliers, wheels, GNSS velocity), each seeded from a master mt19937_64(sim.seed), and a fixed
+// number of draws per sample whatever the options; so changing one sensor's settings leaves the other draws
+// unchanged. Normals are drawn by Box–Muller from the engine's raw bits, so the streams do not depend on the
 // standard library's distribution implementations.
 #pragma once
 
@@ -54,9 +77,10 @@ namespace gins {
 // simulate.* (only `gins simulate` reads it)
 struct SimSegment {
   double duration = 0.0;     // s
-  double accel = 0.0;        // m/s², forward
+  double accel = 0.0;        // m/s², rate of change of the speed (forward, or backwards in reverse)
   double yaw_rate = 0.0;     // rad/s   (yaml: yaw_rate_deg_s)
   double grade = 0.0;        // rad, road pitch reached at the end of the segment (yaml: grade_deg)
+  bool reverse = false;      // driven backwards, the body facing forward
 };
 
 struct SimOptions {
@@ -81,6 +105,11 @@ struct SimOptions {
   double mount_yaw = 12.06 * kDegToRad;
   double wheel_radius = 0.155, pulses_per_rev = 1024.0, wheel_scale = 0.99, wheel_speed_noise = 0.02;
   double track_width = 1.6;
+  // Physics and field-log set-ups (header comment).
+  bool earth_rotation = false;              // the rotating Earth model; false: flat
+  Vec3 gnss_velocity_sigma = Vec3::Zero();  // m/s per ENU axis; all zero: no GVEL records
+  double gnss_noise_correlation = 0.0;      // s, τ of the GNSS position noise; 0: white
+  double log_start = 0.0;                   // s after start_time before which nothing is logged
 };
 
 // The true motion at one instant.
@@ -91,7 +120,8 @@ struct TruthState {
   Quat q_wb = Quat::Identity();
   Vec3 omega_b = Vec3::Zero();  // angular rate of b relative to w, in b (rad/s)
   Vec3 a_w = Vec3::Zero();      // acceleration in w, gravity excluded (m/s²)
-  double speed = 0.0;           // forward speed (m/s), ≥ 0
+  double speed = 0.0;           // speed (m/s), ≥ 0: forward, or backwards when reverse
+  bool reverse = false;         // in a reverse segment: v_w = −speed·R_wb·e_x
 
   NavState ToNavState() const;  // biases zero
 };
@@ -99,13 +129,14 @@ struct TruthState {
 // The exact trajectory defined by SimOptions (segments, initial_yaw, origin, start_time).
 class TruthTrajectory {
  public:
-  // Throws std::invalid_argument when the segments are empty, negative or not finite.
+  // Throws std::invalid_argument when the segments are empty, negative or not finite, or change gear while
+  // the vehicle moves.
   explicit TruthTrajectory(const SimOptions& sim);
 
   double start_time() const { return start_time_; }
   double duration() const { return duration_; }
   double end_time() const { return start_time_ + duration_; }
-  const Vec3& gravity_w() const { return g_w_; }
+  const Vec3& gravity_w() const { return g_w_; }  // the flat model's gravity
   const LocalEnuFrame& frame() const { return frame_; }
 
   // State at an absolute time / at an elapsed time (seconds since start_time), within [0, duration].
@@ -114,7 +145,8 @@ class TruthTrajectory {
   TruthState At(double t) const { return AtElapsed(t - start_time_); }
   TruthState AtElapsed(double s) const;
 
-  // ∫ speed ds and ∫ ω_b.z ds over [s0, s1] (elapsed seconds): the wheels' distances come from these.
+  // ∫ v ds and ∫ ω_b.z ds over [s0, s1] (elapsed seconds), v the signed speed along e_x (negative in
+  // reverse): the wheels' distances come from these.
   Vec2 IntegrateSpeedAndYawRate(double s0, double s1) const;
 
  private:
@@ -134,6 +166,10 @@ class TruthTrajectory {
     const Piece& Find(double s) const;
     std::vector<Piece> pieces_;
   };
+  struct Gear {
+    double t0;     // elapsed time the segment starts
+    bool reverse;
+  };
   struct SpeedPhase {
     double t0;    // elapsed time the phase starts
     bool moving;  // moving: speed = A(s) − A(t0) with A = ∫ accel; stopped: speed 0
@@ -141,6 +177,9 @@ class TruthTrajectory {
   };
 
   void ComputeSpeedPhases();
+  // Throws unless every change of gear happens at a standstill. names[i]: the segment starting gears_[i].
+  void CheckGearChanges(const std::vector<std::string>& names) const;
+  bool Reverse(double s) const;
   const SpeedPhase& Phase(double s) const;
   double Speed(double s) const;
   double Yaw(double s) const { return initial_yaw_ + yaw_rate_.Integral(s); }
@@ -155,35 +194,56 @@ class TruthTrajectory {
   LocalEnuFrame frame_;
   Profile accel_, yaw_rate_, grade_;
   std::vector<SpeedPhase> phases_;
+  std::vector<Gear> gears_;    // one per segment of positive duration, in time order
   std::vector<double> knots_;  // elapsed times; every break of smoothness is a knot
   std::vector<Vec3> knot_p_;   // p_wb at the knots
 };
 
 // One simulated log record with the truth at its time.
 struct SimRecord {
-  enum class Type { kImu, kOdom, kGnss };
+  enum class Type { kImu, kOdom, kGnss, kGvel };
   Type type = Type::kImu;
   ImuSample imu;    // valid when type == kImu
   OdomRecord odom;  // valid when type == kOdom
   GnssRecord gnss;  // valid when type == kGnss
+  GvelRecord gvel;  // valid when type == kGvel
   // Truth at t() with the true IMU biases of the latest IMU sample (exact for IMU records).
   NavState truth;
   bool gnss_outlier = false;  // this fix was displaced as an outlier
 
-  double t() const { return type == Type::kImu ? imu.t : type == Type::kOdom ? odom.t : gnss.t; }
+  double t() const {
+    switch (type) {
+      case Type::kImu:
+        return imu.t;
+      case Type::kOdom:
+        return odom.t;
+      case Type::kGnss:
+        return gnss.t;
+      case Type::kGvel:
+        return gvel.t;
+    }
+    return gnss.t;
+  }
 };
 
 // The measurement stream of a drive, generated lazily in time order.
 class Simulator {
  public:
-  // Throws std::invalid_argument on invalid options (rates, σ, probabilities, segments).
+  // Throws std::invalid_argument on invalid options (rates, σ, probabilities, segments, log_start).
   explicit Simulator(const SimOptions& sim);
 
-  // Next record in time order; false at the end of the drive.
+  // Next record in time order (from start_time + log_start on); false at the end of the drive.
   bool Next(SimRecord* record);
 
   const TruthTrajectory& truth() const { return truth_; }
   const SimOptions& options() const { return sim_; }
+  // ω_ie in w (rad/s): zero for the flat model.
+  const Vec3& earth_rate_w() const { return earth_rate_w_; }
+  // The model's gravity at p_w: constant (flat) or exact normal gravity (rotating).
+  Vec3 GravityAt(const Vec3& p_w) const;
+  // R_w_l at p_w: takes vectors in the local ENU frame at p_w into w. Identity for the flat model, whose
+  // outputs are given in w.
+  Mat3 LocalToWorld(const Vec3& p_w) const;
 
  private:
   // Uniform and standard normal draws from one engine, independent of the library's distributions.
@@ -198,30 +258,46 @@ class Simulator {
     std::mt19937_64 engine_;
   };
 
+  // The next record of the whole drive (before the log_start cut); *from: the elapsed time the record
+  // starts measuring at (its time, or the start of an encoder interval).
+  bool Generate(SimRecord* r, double* from);
   void MakeImu(SimRecord* r);
   void MakeOdom(SimRecord* r);
-  // Draws the fix's noise; false (no record) inside an outage.
+  // Draws the fix's noise; false (no record) inside an outage. Queues the fix's GVEL record, if any.
   bool MakeGnss(SimRecord* r);
+  // The GNSS position error of the epoch just counted in i_gnss_, from its standard normals (white or
+  // Gauss–Markov).
+  Vec3 GnssError(const Vec3& normals);
+  // Queues the GVEL record of the fix at elapsed s (truth x, true antenna position p_ant_w), all but its
+  // truth.
+  void MakeGvel(double s, const TruthState& x, const Vec3& p_ant_w, const Vec3& normals);
   void FillTruth(double elapsed, SimRecord* r) const;
 
   SimOptions sim_;
   TruthTrajectory truth_;
   Rng rng_imu_bias_, rng_imu_noise_, rng_gnss_, rng_heading_, rng_heading_valid_, rng_outlier_, rng_wheel_;
+  Rng rng_gvel_;
+  Vec3 earth_rate_w_ = Vec3::Zero();
   uint64_t n_imu_ = 0, n_gnss_ = 0, n_odom_ = 0;  // samples in the drive per stream
   uint64_t i_imu_ = 0, i_gnss_ = 0, i_odom_ = 1;  // next sample index per stream
   Vec3 bg_ = Vec3::Zero(), ba_ = Vec3::Zero();    // current true biases
   Vec2 pulse_carry_ = Vec2::Zero();               // sub-pulse remainders (left, right)
+  Vec3 gnss_error_ = Vec3::Zero();                // the Gauss–Markov GNSS error of the last epoch
+  bool gvel_pending_ = false;                     // pending_ holds the last fix's GVEL record
+  SimRecord pending_;
+  double pending_from_ = 0.0;
 };
 
 struct SimulationResult {
-  uint64_t imu = 0, gnss = 0, odom = 0;
-  double duration = 0.0;  // s
+  uint64_t imu = 0, gnss = 0, odom = 0, gvel = 0;
+  double duration = 0.0;  // s, of the whole drive (from start_time, whatever log_start)
 };
 
 // Runs the drive and writes out_dir/log.txt (DESIGN §3, with a `# gins simulate seed=...` header) and
-// out_dir/truth.csv (DESIGN §5, one row per IMU sample). out_dir is created if missing. Each file is
-// written under a temporary name and renamed into place when complete. Throws std::invalid_argument on
-// invalid options and std::runtime_error on I/O failure.
+// out_dir/truth.csv (DESIGN §5, one row per IMU record; attitude and velocity in the local ENU frame at the
+// row's point when rotating, in w when flat). out_dir is created if missing. Each file is written under a
+// temporary name and renamed into place when complete. Throws std::invalid_argument on invalid options and
+// std::runtime_error on I/O failure.
 SimulationResult Simulate(const SimOptions& sim, const std::string& out_dir);
 
 }  // namespace gins

@@ -698,7 +698,9 @@ TEST(ConfigLoaderTest, EchoIsWrittenInUsersUnitsWithShortNumbers) {
 
 TEST(ConfigLoaderTest, EchoWritesSegmentsOutagesAndMatrices) {
   const std::string yaml = OptionsToYaml(NonDefaultOptions());
-  EXPECT_NE(yaml.find("- {duration_s: 10, accel_m_s2: 1, yaw_rate_deg_s: 9, grade_deg: 3}"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("- {duration_s: 10, accel_m_s2: 1, yaw_rate_deg_s: 9, grade_deg: 3, reverse: false}"),
+            std::string::npos)
+      << yaml;
   EXPECT_NE(yaml.find("gnss_outages_s: [[40, 15], [100.5, 2]]"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("axes: [0, 0, 1, 1, 0, 0, 0, 1, 0]"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("initial_heading_deg: 30"), std::string::npos) << yaml;

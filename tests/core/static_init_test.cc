@@ -74,6 +74,8 @@ InitRun Feed(const SimOptions& sim, const Options& options) {
         }
         break;
       }
+      case SimRecord::Type::kGvel:  // the initialiser takes no GNSS velocity (yet)
+        break;
     }
   }
   run.diagnosis = init.Diagnosis();

@@ -134,9 +134,11 @@ int RunCli(int argc, const char* const* argv) {
       const Options options = LoadOptions(sim_config);
       std::filesystem::create_directories(sim_out);
       const SimulationResult r = Simulate(options.simulate, sim_out);
-      std::printf("gins simulate: %.1f s, %llu IMU, %llu GNSS, %llu ODOM records -> %s/log.txt, %s/truth.csv\n",
+      std::printf("gins simulate: %.1f s, %llu IMU, %llu GNSS, %llu GVEL, %llu ODOM records -> %s/log.txt, "
+                  "%s/truth.csv\n",
                   r.duration, static_cast<unsigned long long>(r.imu), static_cast<unsigned long long>(r.gnss),
-                  static_cast<unsigned long long>(r.odom), sim_out.c_str(), sim_out.c_str());
+                  static_cast<unsigned long long>(r.gvel), static_cast<unsigned long long>(r.odom), sim_out.c_str(),
+                  sim_out.c_str());
       return 0;
     }
   } catch (const std::exception& e) {

@@ -17,7 +17,8 @@ inline void FeedSession(Session* session, const SimRecord& rec) {
     case SimRecord::Type::kGnss:
       session->AddGnss(rec.gnss);
       break;
-    case SimRecord::Type::kGvel:  // the session gains GNSS velocity separately
+    case SimRecord::Type::kGvel:
+      session->AddGvel(rec.gvel);
       break;
   }
 }

@@ -9,10 +9,10 @@
 
 #include "apps/convert_command.h"
 #include "apps/eval_command.h"
+#include "apps/run_command.h"
 #include "config/config_loader.h"
 #include "core/io/log_reader.h"
 #include "core/sim/simulator.h"
-#include "solver/runner.h"
 
 namespace gins {
 namespace {

@@ -1,5 +1,5 @@
-// One run: read the log once, initialise, feed every estimator the same time-ordered measurement stream,
-// write each estimator's outputs and the run summary. The app is a thin shell around this.
+// `gins run`: read the log once, initialise, feed every estimator the same time-ordered measurement stream,
+// write each estimator's outputs and the run summary. The command line is a thin shell around this.
 #pragma once
 
 #include <map>
@@ -10,17 +10,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "config/options.h"
 #include "core/eval/trajectory_metrics.h"
-#include "core/io/log_reader.h"
-#include "solver/estimator_options.h"
 #include "solver/session.h"
 
 namespace gins {
-
-// What one run reads: the estimators' options and how to read the log.
-struct RunOptions : EstimatorOptions {
-  InputOptions input;
-};
 
 struct RunRequest {
   std::string log_path;
@@ -41,7 +35,7 @@ struct RunResult {
 
 // Throws InputError (bad log), RunError (no solution possible) or std::runtime_error (I/O). Nothing is
 // left in out_dir when it throws.
-RunResult Run(const RunOptions& options, const RunRequest& request);
+RunResult Run(const Options& options, const RunRequest& request);
 
 // The estimator modes Run() accepts.
 std::vector<std::string> SupportedModes();

@@ -1,4 +1,4 @@
-#include "solver/runner.h"
+#include "apps/run_command.h"
 
 #include <algorithm>
 #include <chrono>
@@ -90,7 +90,7 @@ void CheckTruth(const std::string& path, const LocalEnuFrame& frame) {
 }
 
 // Every record of the log to the session, in file order.
-void FeedLog(const RunOptions& options, const RunRequest& request, LogReader* reader, Session* session) {
+void FeedLog(const Options& options, const RunRequest& request, LogReader* reader, Session* session) {
   LogRecord rec;
   while (reader->Next(&rec)) {
     switch (rec.type) {
@@ -158,7 +158,7 @@ nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nloh
 
 // The summary up to the outputs: the run, its input, the estimators, timing, and the GNSS outage windows
 // (simulated ones and the log's own gaps, absolute times) that the comparison scores the drift over.
-nlohmann::json RunSummary(const RunOptions& options, const RunRequest& request, const ReadStats& rs,
+nlohmann::json RunSummary(const Options& options, const RunRequest& request, const ReadStats& rs,
                           const Session& session, const Streams& streams, Clock::time_point wall_start) {
   nlohmann::json j;
   j["gins_version"] = "0.1.0";
@@ -221,7 +221,7 @@ void AddComparison(const RunRequest& request, const Session& session, const Stre
 
 std::vector<std::string> SupportedModes() { return {"eskf", "smoother", "both"}; }
 
-RunResult Run(const RunOptions& options, const RunRequest& request) {
+RunResult Run(const Options& options, const RunRequest& request) {
   const auto wall_start = Clock::now();
   CheckMode(request.mode);
   LogReader reader(request.log_path, options.input);

@@ -118,9 +118,10 @@ void LogReader::Impl::CheckTime(const LogRecord& record, const char** reason, st
   const size_t k = static_cast<size_t>(record.type);
   const double t = record.t();
   const double max_jump = options_.max_time_jump;
-  if (have_newest_ && t < newest_t_) {
+  if (have_newest_ && t < newest_t_ - options_.reorder_window) {
     *reason = kOutOfOrder;
     *detail = "t = " + Time(t) + " is older than the newest time read, " + Time(newest_t_);
+    if (options_.reorder_window > 0.0) *detail += ", by more than input.reorder_window_s";
   } else if (have_newest_ && max_jump > 0.0 && t - newest_t_ > max_jump) {
     const bool agrees = jump_run_ > 0 && t >= jump_last_t_ && t - jump_last_t_ <= max_jump;
     jump_run_ = agrees ? jump_run_ + 1 : 1;
@@ -146,7 +147,8 @@ void LogReader::Impl::CheckTime(const LogRecord& record, const char** reason, st
 void LogReader::Impl::Accept(LogRecord* record, uint64_t line) {
   const size_t k = static_cast<size_t>(record->type);
   jump_run_ = 0;  // a record in time order ends any run of jumped ones
-  newest_t_ = record->t();
+  // Within the reorder window a record may be older than the newest one.
+  newest_t_ = have_newest_ ? std::max(newest_t_, record->t()) : record->t();
   have_newest_ = true;
   last_t_[k] = newest_t_;
   have_last_[k] = true;

@@ -203,6 +203,26 @@ TEST_F(LogReaderTest, OlderRecordOfSameTypeAndTimeIsOutOfOrderNotDuplicate) {
   EXPECT_EQ(r.stats.skipped.count("duplicate"), 0u);
 }
 
+// input.reorder_window_s: a record up to the window older than the newest passes (the API sorts it into
+// place); older is out_of_order, measured against the newest time, not the last record read.
+TEST_F(LogReaderTest, ReorderWindowLetsSlightlyOlderRecordsThrough) {
+  const std::string text = Imu("2.0") + "\nGNSS 1.7 31.5 120.4 10.5 170.9 1\n" + Imu("1.9") + "\n" + Imu("1.4") +
+                           "\n" + Imu("2.1") + "\n";
+  const ReadResult off = ReadAll(Write("log.txt", text));
+  EXPECT_EQ(off.records.size(), 2u);
+  EXPECT_EQ(off.stats.skipped.at("out_of_order"), 3u);
+  InputOptions window;
+  window.reorder_window = 0.5;
+  const ReadResult on = ReadAll(Write("log2.txt", text), window);
+  ASSERT_EQ(on.records.size(), 4u);
+  EXPECT_EQ(on.records[1].t(), 1.7);
+  EXPECT_EQ(on.records[2].t(), 1.9);
+  EXPECT_EQ(on.stats.skipped.at("out_of_order"), 1u);
+  ASSERT_EQ(on.stats.examples.size(), 1u);
+  EXPECT_EQ(on.stats.examples[0].line, 4u);
+  EXPECT_NE(on.stats.examples[0].detail.find("input.reorder_window_s"), std::string::npos);
+}
+
 // A corrupted far-future time stamp costs that one line: the records after it are read (not out_of_order).
 TEST_F(LogReaderTest, FarFutureTimeStampIsOneTimeJumpNotEveryLaterLine) {
   std::string text;

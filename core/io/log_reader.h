@@ -101,6 +101,11 @@ struct ReadStats {
 enum class LineParse { kRecord, kBlank, kDamaged };
 LineParse ParseLogLine(std::string_view line, LogRecord* record, InputIssue* issue);
 
+// The same checks on a record that did not come from a line (the API's pushes): every number finite, then
+// ParseLogLine's range checks; on success the record is made what ParseLogLine would have made of it (a
+// valid heading normalised into [0, 360), an invalid one 0). Returns kRecord or kDamaged with *issue filled.
+LineParse CheckLogRecord(LogRecord* record, InputIssue* issue);
+
 class LogReader {
  public:
   // Throws InputError if the file cannot be opened or read.

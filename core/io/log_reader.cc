@@ -41,8 +41,11 @@ class LogReader::Impl {
  public:
   Impl(const std::string& path, const InputOptions& options, ReadStats* stats)
       : path_(path), options_(options), stats_(stats), lines_(path, options.max_line_length) {}
+  Impl(int fd, const std::string& name, const InputOptions& options, ReadStats* stats, int stop_fd)
+      : path_(name), options_(options), stats_(stats), lines_(fd, name, options.max_line_length, stop_fd) {}
 
   bool Next(LogRecord* record);
+  bool stopped() const { return lines_.stopped(); }
 
  private:
   // Handles a line that cannot be parsed as it stands (too long, or the cut last line); true if it was one.
@@ -215,7 +218,14 @@ LogReader::LogReader(const std::string& path, const InputOptions& options) : pat
   impl_ = std::make_unique<Impl>(path_, options_, &stats_);
 }
 
+LogReader::LogReader(int fd, const std::string& name, const InputOptions& options, int stop_fd)
+    : path_(name), options_(options) {
+  impl_ = std::make_unique<Impl>(fd, path_, options_, &stats_, stop_fd);
+}
+
 LogReader::~LogReader() = default;
+
+bool LogReader::stopped() const { return impl_->stopped(); }
 
 bool LogReader::Next(LogRecord* record) { return impl_->Next(record); }
 

@@ -110,6 +110,9 @@ class LogReader {
  public:
   // Throws InputError if the file cannot be opened or read.
   LogReader(const std::string& path, const InputOptions& options);
+  // A stream read as it arrives (LineSource's fd constructor: plain text, each line handed on when its '\n'
+  // is read, the end at EOF or when stop_fd becomes readable); `name` stands for the path in messages.
+  LogReader(int fd, const std::string& name, const InputOptions& options, int stop_fd = -1);
   ~LogReader();
   LogReader(const LogReader&) = delete;
   LogReader& operator=(const LogReader&) = delete;
@@ -120,6 +123,8 @@ class LogReader {
 
   const ReadStats& stats() const { return stats_; }
   const std::string& path() const { return path_; }
+  // The stream ended because stop_fd became readable (not at EOF).
+  bool stopped() const;
 
  private:
   class Impl;

@@ -123,10 +123,10 @@ int RunCli(int argc, const char* const* argv) {
   if (*convert) return RunConvert(convert_req);
   try {
     if (*run) {
-      const Options options = LoadOptions(config_path);
+      const api::Config config = api::Config::FromFile(config_path);
       req.config_path = config_path;
       if (!truth_path.empty()) req.truth_path = truth_path;
-      const RunResult result = Run(options, req);
+      const RunResult result = Run(config, req);
       PrintRunReport(req, result);
       return 0;
     }

@@ -10,6 +10,7 @@
 #include "apps/convert_command.h"
 #include "apps/eval_command.h"
 #include "apps/run_command.h"
+#include "apps/stream_command.h"
 #include "config/config_loader.h"
 #include "core/io/log_reader.h"
 #include "core/sim/simulator.h"
@@ -110,6 +111,8 @@ int RunCli(int argc, const char* const* argv) {
   auto* eval = AddEvalCommand(app, &eval_req);
   ConvertRequest convert_req;  // gins convert (apps/convert_command.h)
   auto* convert = AddConvertCommand(app, &convert_req);
+  StreamRequest stream_req;  // gins stream (apps/stream_command.h)
+  auto* stream = AddStreamCommand(app, &stream_req);
 
   try {
     app.parse(argc, argv);
@@ -119,6 +122,13 @@ int RunCli(int argc, const char* const* argv) {
     return code == 0 ? 0 : 2;
   }
 
+  if (*stream) {
+    if (stream_req.online && stream_req.mode != "smoother") {
+      std::fprintf(stderr, "gins stream: --online needs --mode smoother\n");
+      return 2;
+    }
+    return RunStream(stream_req, 0, stdout);
+  }
   if (*eval) return RunEval(eval_req);
   if (*convert) return RunConvert(convert_req);
   try {

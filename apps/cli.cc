@@ -9,6 +9,7 @@
 
 #include "apps/convert_command.h"
 #include "apps/eval_command.h"
+#include "apps/report_command.h"
 #include "apps/run_command.h"
 #include "apps/stream_command.h"
 #include "config/config_loader.h"
@@ -113,6 +114,8 @@ int RunCli(int argc, const char* const* argv) {
   auto* convert = AddConvertCommand(app, &convert_req);
   StreamRequest stream_req;  // gins stream (apps/stream_command.h)
   auto* stream = AddStreamCommand(app, &stream_req);
+  ReportRequest report_req;  // gins report (apps/report_command.h)
+  auto* report = AddReportCommand(app, &report_req);
 
   try {
     app.parse(argc, argv);
@@ -129,6 +132,7 @@ int RunCli(int argc, const char* const* argv) {
     }
     return RunStream(stream_req, 0, stdout);
   }
+  if (*report) return RunReport(report_req);
   if (*eval) return RunEval(eval_req);
   if (*convert) return RunConvert(convert_req);
   try {

@@ -23,7 +23,8 @@ struct RunEntry {
 // for summary.json files (in path order). A directory with none of them is a run without a summary.
 std::vector<RunEntry> FindRuns(const std::vector<std::string>& inputs) {
   std::vector<RunEntry> runs;
-  for (const std::string& input : inputs) {
+  for (std::string input : inputs) {
+    while (input.size() > 1 && input.back() == '/') input.pop_back();  // "out/fleet/*/" names dirs
     const fs::path p(input);
     if (fs::is_regular_file(p)) {
       runs.push_back({p.parent_path().string(), input});

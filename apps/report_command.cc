@@ -84,8 +84,9 @@ void PrintTable(const nlohmann::json& rows) {
     }
     const auto& h = r["rmse_horizontal_m"];
     std::printf("%-24s %-24s %9s %-8s %11s %11s %11s %8llu %8llu %8llu %7s\n",
-                Tail(r["run"].get<std::string>(), 24).c_str(), Tail(r["log"].get<std::string>(), 24).c_str(), Fixed(r["duration_s"], "%.1f").c_str(),
-                r["mode"].get<std::string>().c_str(), Fixed(h.value("eskf", nlohmann::json()), "%.3f").c_str(),
+                Tail(r["run"].get<std::string>(), 24).c_str(), Tail(r["log"].get<std::string>(), 24).c_str(),
+                Fixed(r["duration_s"], "%.1f").c_str(), r["mode"].get<std::string>().c_str(),
+                Fixed(h.value("eskf", nlohmann::json()), "%.3f").c_str(),
                 Fixed(h.value("smoother", nlohmann::json()), "%.3f").c_str(),
                 Fixed(h.value("smoother_online", nlohmann::json()), "%.3f").c_str(),
                 static_cast<unsigned long long>(Count(r, "rejected")),
@@ -163,8 +164,8 @@ CLI::App* AddReportCommand(CLI::App& app, ReportRequest* req) {
 int RunReport(const ReportRequest& req) {
   try {
     nlohmann::json rows = nlohmann::json::array();
-    nlohmann::json totals = {{"runs", 0}, {"missing", 0}, {"duration_s", 0.0}, {"rejected", 0},
-                             {"skipped_lines", 0}, {"watchdog_resets", 0}};
+    nlohmann::json totals = {{"runs", 0},     {"missing", 0},       {"duration_s", 0.0},
+                             {"rejected", 0}, {"skipped_lines", 0}, {"watchdog_resets", 0}};
     for (const RunEntry& e : FindRuns(req.inputs)) {
       if (e.summary.empty()) {
         rows.push_back({{"run", e.run}, {"error", "no summary.json (the run failed or has not finished)"}});

@@ -101,17 +101,17 @@ class StateLines {
 void Report(const ReadStats& rs, const StateLines& lines, api::Stream stream, int signal) {
   std::string skipped;
   for (const auto& [reason, n] : rs.skipped) skipped += " " + reason + " " + std::to_string(n);
-  std::fprintf(stderr,
-               "gins stream: %llu lines: %llu IMU, %llu ODOM, %llu GNSS, %llu GVEL records; %llu damaged lines "
-               "skipped%s%s; %llu %s states written%s%s\n",
-               static_cast<unsigned long long>(rs.lines), static_cast<unsigned long long>(rs.imu),
-               static_cast<unsigned long long>(rs.odom), static_cast<unsigned long long>(rs.gnss),
-               static_cast<unsigned long long>(rs.gvel), static_cast<unsigned long long>(rs.total_skipped()),
-               skipped.empty() ? "" : " (", skipped.empty() ? "" : (skipped.substr(1) + ")").c_str(),
-               static_cast<unsigned long long>(lines.written()), api::StreamName(stream),
-               lines.non_finite() > 0 ? (", " + std::to_string(lines.non_finite()) + " not finite skipped").c_str()
-                                      : "",
-               signal != 0 ? (std::string("; input ended by SIG") + sigabbrev_np(signal)).c_str() : "");
+  std::fprintf(
+      stderr,
+      "gins stream: %llu lines: %llu IMU, %llu ODOM, %llu GNSS, %llu GVEL records; %llu damaged lines "
+      "skipped%s%s; %llu %s states written%s%s\n",
+      static_cast<unsigned long long>(rs.lines), static_cast<unsigned long long>(rs.imu),
+      static_cast<unsigned long long>(rs.odom), static_cast<unsigned long long>(rs.gnss),
+      static_cast<unsigned long long>(rs.gvel), static_cast<unsigned long long>(rs.total_skipped()),
+      skipped.empty() ? "" : " (", skipped.empty() ? "" : (skipped.substr(1) + ")").c_str(),
+      static_cast<unsigned long long>(lines.written()), api::StreamName(stream),
+      lines.non_finite() > 0 ? (", " + std::to_string(lines.non_finite()) + " not finite skipped").c_str() : "",
+      signal != 0 ? (std::string("; input ended by SIG") + sigabbrev_np(signal)).c_str() : "");
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // (gins/gins.h) like `gins run`, so the numbers are the same; for live data and pipelines.
 #pragma once
 
+#include <cstdio>
 #include <string>
 
 #include <CLI/CLI.hpp>

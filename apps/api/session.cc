@@ -29,9 +29,7 @@ class Session::Impl {
   void Finish();
   void OnState(StateCallback callback) { callback_ = std::move(callback); }
   bool Poll(State* state);
-  bool init_timed_out() const {
-    return !session_.initialized() && session_.elapsed() > options_.init.max_wait;
-  }
+  bool init_timed_out() const { return !session_.initialized() && session_.elapsed() > options_.init.max_wait; }
   Status GetStatus() const;
   nlohmann::json Stats() const;
   const ::gins::Session& session() const { return session_; }
@@ -50,17 +48,19 @@ class Session::Impl {
   std::deque<State> queue_;
   std::exception_ptr callback_error_;  // the first exception of the current call, rethrown at its end
   bool finished_ = false;
-  InputIssue issue_;  // reused: a valid record allocates nothing
+  InputIssue issue_;                                                  // reused: a valid record allocates nothing
   std::map<std::pair<std::string, std::string>, uint64_t> rejected_;  // (measurement, reason) -> count
   uint64_t accepted_ = 0, rejected_total_ = 0, states_ = 0, states_dropped_ = 0, callback_errors_ = 0;
 };
 
 Session::Impl::Impl(const Options& options, const SessionOptions& session_options)
-    : options_(options), session_options_(session_options), session_(options_), reorder_(options_.input.reorder_window) {
+    : options_(options),
+      session_options_(session_options),
+      session_(options_),
+      reorder_(options_.input.reorder_window) {
   const Mode mode = session_options_.mode;
   if (mode == Mode::kEskf || mode == Mode::kBoth) {
-    session_.AddEstimator(
-        std::make_unique<Eskf>(options_, [this](const StateEstimate& e) { Emit(Stream::kEskf, e); }));
+    session_.AddEstimator(std::make_unique<Eskf>(options_, [this](const StateEstimate& e) { Emit(Stream::kEskf, e); }));
   }
   if (mode == Mode::kSmoother || mode == Mode::kBoth) {
     session_.AddEstimator(std::make_unique<Smoother>(
@@ -190,9 +190,12 @@ nlohmann::json Session::Impl::Stats() const {
   nlohmann::json j = session_.Stats();
   nlohmann::json rejected = nlohmann::json::object();
   for (const auto& [key, count] : rejected_) rejected[key.first][key.second] = count;
-  j["session"] = {{"accepted", accepted_},         {"reorder_window_s", reorder_.window()},
-                  {"reordered", reorder_.reordered()}, {"rejected", rejected},
-                  {"states", states_},             {"states_dropped", states_dropped_},
+  j["session"] = {{"accepted", accepted_},
+                  {"reorder_window_s", reorder_.window()},
+                  {"reordered", reorder_.reordered()},
+                  {"rejected", rejected},
+                  {"states", states_},
+                  {"states_dropped", states_dropped_},
                   {"callback_errors", callback_errors_}};
   return j;
 }

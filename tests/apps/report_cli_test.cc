@@ -1,7 +1,5 @@
 // `gins report`: one row per run, the numbers of each run's summary.json, folders searched for runs, and a
 // run without a summary listed and failing the exit code.
-#include "apps/report_command.h"
-
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -11,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/report_command.h"
 #include "test_util.h"
 
 namespace gins {
@@ -43,11 +42,11 @@ class ReportCliTest : public ::testing::Test {
     dir_ = test::MakeTempDir("report");
     const std::string data = GINS_TEST_DATA_DIR;
     std::string out;
-    ASSERT_EQ(Shell(kGins + " run --config " + GINS_SOURCE_DIR + "/config/default.yaml --log " + data +
-                        "/sample/log.txt.gz --truth " + data + "/sample/truth.csv.gz --mode eskf --out " + dir_ +
-                        "/runs/a",
-                    dir_, &out),
-              0);
+    ASSERT_EQ(
+        Shell(kGins + " run --config " + GINS_SOURCE_DIR + "/config/default.yaml --log " + data +
+                  "/sample/log.txt.gz --truth " + data + "/sample/truth.csv.gz --mode eskf --out " + dir_ + "/runs/a",
+              dir_, &out),
+        0);
     fs::copy(dir_ + "/runs/a", dir_ + "/runs/b");
     fs::copy(dir_ + "/runs/a", dir_ + "/runs/c");
     // c: a run with damaged lines, a watchdog reset and no truth.

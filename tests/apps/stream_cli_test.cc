@@ -171,8 +171,8 @@ TEST(StreamCliTest, EqualsRunInBothModesAndFormats) {
     EXPECT_EQ(code, 0) << err;
     const std::string expected = test::ReadFile(dir + "/run/" + c.file);
     EXPECT_GT(CountLines(expected), 100u);
-    EXPECT_TRUE(out == expected) << c.file << ": " << CountLines(out) << " lines streamed, "
-                                 << CountLines(expected) << " in the run's file";
+    EXPECT_TRUE(out == expected) << c.file << ": " << CountLines(out) << " lines streamed, " << CountLines(expected)
+                                 << " in the run's file";
     EXPECT_NE(err.find("19969 lines: 18001 IMU, 1800 ODOM, 166 GNSS"), std::string::npos) << err;
   }
 }
@@ -249,14 +249,54 @@ TEST(StreamCliTest, DamagedLinesFollowTheRunPolicy) {
   const std::string out = Stream({"stream", "--config", kConfig}, damaged, dir, &code, &err);
   EXPECT_EQ(code, 0) << err;
   EXPECT_TRUE(out == test::ReadFile(dir + "/run/eskf.tum"));
-  EXPECT_NE(err.find("3 damaged lines skipped (bad_number 1 out_of_order 1 unknown_type 1)"), std::string::npos)
-      << err;
+  EXPECT_NE(err.find("3 damaged lines skipped (bad_number 1 out_of_order 1 unknown_type 1)"), std::string::npos) << err;
 
   test::WriteFile(dir + "/stop.yaml", "input:\n  on_error: stop\n");
   Stream({"stream", "--config", dir + "/stop.yaml"}, damaged, dir, &code, &err);
   EXPECT_EQ(code, 1);
   EXPECT_NE(err.find("gins: error: <stdin>:4001: bad_number: field 4 (gy) 'abc' is not a number"), std::string::npos)
       << err;
+}
+
+// GNSS lines that arrive 0.15 s late (as from a live receiver): with input.reorder_window_s 0.2 both
+// gins stream and gins run sort them into place and give the states of the log in time order; without the
+// window they are out_of_order damage in both.
+TEST(StreamCliTest, LateLinesWithinTheReorderWindowAreSortedInBothCommands) {
+  const std::string dir = test::MakeTempDir("stream_reorder");
+  std::istringstream in(SampleText());
+  std::string line, late;
+  std::vector<std::pair<double, std::string>> waiting;
+  size_t moved = 0;
+  while (std::getline(in, line)) {
+    const double t = line[0] == '#' ? 0.0 : std::stod(line.substr(line.find(' ') + 1));
+    while (!waiting.empty() && t > waiting.front().first + 0.15) {
+      late += waiting.front().second + "\n";
+      waiting.erase(waiting.begin());
+      ++moved;
+    }
+    if (line.rfind("GNSS", 0) == 0) {
+      waiting.emplace_back(t, line);
+    } else {
+      late += line + "\n";
+    }
+  }
+  for (const auto& w : waiting) late += w.second + "\n";
+  ASSERT_GT(moved, 100u);
+  test::WriteFile(dir + "/late.txt", late);
+  test::WriteFile(dir + "/reorder.yaml", "input:\n  reorder_window_s: 0.2\n");
+  ASSERT_EQ(GinsRun(kSample, dir + "/in_order", "eskf"), 0);
+  const std::string expected = test::ReadFile(dir + "/in_order/eskf.tum");
+  int code = -1;
+  std::string err;
+  EXPECT_TRUE(Stream({"stream", "--config", dir + "/reorder.yaml"}, late, dir, &code, &err) == expected);
+  EXPECT_EQ(code, 0) << err;
+  EXPECT_NE(err.find("0 damaged lines"), std::string::npos) << err;
+  ASSERT_EQ(GinsRun(dir + "/late.txt", dir + "/run_late", "eskf", dir + "/reorder.yaml"), 0);
+  EXPECT_TRUE(test::ReadFile(dir + "/run_late/eskf.tum") == expected);
+
+  Stream({"stream", "--config", kConfig}, late, dir, &code, &err);
+  EXPECT_EQ(code, 0) << err;
+  EXPECT_NE(err.find("out_of_order " + std::to_string(moved)), std::string::npos) << err;
 }
 
 TEST(StreamCliTest, InputWithoutASolutionIsAnError) {

@@ -58,31 +58,31 @@ class Error : public std::runtime_error {
 
 // --- Measurements, as logged (the log format of DESIGN §3, one struct per record type) --------------------
 
-struct Imu {                     // IMU record
+struct Imu {  // IMU record
   double t = 0.0;
-  double gyro[3] = {0, 0, 0};    // rad/s, in the IMU's axes (imu.axes maps them into the body frame)
-  double acc[3] = {0, 0, 0};     // m/s², specific force, the same axes
+  double gyro[3] = {0, 0, 0};  // rad/s, in the IMU's axes (imu.axes maps them into the body frame)
+  double acc[3] = {0, 0, 0};   // m/s², specific force, the same axes
 };
 
-struct Wheel {                   // ODOM record
+struct Wheel {  // ODOM record
   double t = 0.0;
-  double left_pulses = 0.0;      // encoder pulses counted over (t - wheel.interval_s, t]
+  double left_pulses = 0.0;  // encoder pulses counted over (t - wheel.interval_s, t]
   double right_pulses = 0.0;
 };
 
-struct Gnss {                    // GNSS record
+struct Gnss {  // GNSS record
   double t = 0.0;
   double lat_deg = 0.0, lon_deg = 0.0;
-  double alt_m = 0.0;            // ellipsoidal height
-  double heading_deg = 0.0;      // dual-antenna baseline, clockwise from true north
+  double alt_m = 0.0;        // ellipsoidal height
+  double heading_deg = 0.0;  // dual-antenna baseline, clockwise from true north
   bool heading_valid = false;
-  bool has_sigma = false;        // sigma_enu holds the fix's 1-σ (else the config's gnss.sigma_m)
+  bool has_sigma = false;           // sigma_enu holds the fix's 1-σ (else the config's gnss.sigma_m)
   double sigma_enu[3] = {0, 0, 0};  // m, east, north, up
 };
 
-struct GnssVelocity {            // GVEL record
+struct GnssVelocity {  // GVEL record
   double t = 0.0;
-  double v_enu[3] = {0, 0, 0};   // antenna velocity, m/s, local east, north, up at the fix
+  double v_enu[3] = {0, 0, 0};  // antenna velocity, m/s, local east, north, up at the fix
   bool has_sigma = false;
   double sigma_enu[3] = {0, 0, 0};  // m/s
 };
@@ -123,17 +123,17 @@ struct Geodetic {
 struct State {
   Stream stream = Stream::kEskf;
   double t = 0.0;
-  double p_enu[3] = {0, 0, 0};       // body origin in w, m
-  double lla[3] = {0, 0, 0};         // the same point: latitude, longitude (deg), ellipsoidal height (m);
-                                     // NaN when SessionOptions::geodetic is off
-  double v_enu[3] = {0, 0, 0};       // m/s, in w
-  double q_wb[4] = {1, 0, 0, 0};     // w, x, y, z
-  double gyro_bias[3] = {0, 0, 0};   // rad/s
-  double acc_bias[3] = {0, 0, 0};    // m/s²
-  double sigma_p[3] = {0, 0, 0};     // 1-σ of p_enu, m
-  double sigma_v[3] = {0, 0, 0};     // 1-σ of v_enu, m/s
-  double sigma_att[3] = {0, 0, 0};   // 1-σ of the attitude about the E, N, U axes, rad (the last is yaw)
-  double odom_scale = 1.0;           // wheel odometer scale factor
+  double p_enu[3] = {0, 0, 0};      // body origin in w, m
+  double lla[3] = {0, 0, 0};        // the same point: latitude, longitude (deg), ellipsoidal height (m);
+                                    // NaN when SessionOptions::geodetic is off
+  double v_enu[3] = {0, 0, 0};      // m/s, in w
+  double q_wb[4] = {1, 0, 0, 0};    // w, x, y, z
+  double gyro_bias[3] = {0, 0, 0};  // rad/s
+  double acc_bias[3] = {0, 0, 0};   // m/s²
+  double sigma_p[3] = {0, 0, 0};    // 1-σ of p_enu, m
+  double sigma_v[3] = {0, 0, 0};    // 1-σ of v_enu, m/s
+  double sigma_att[3] = {0, 0, 0};  // 1-σ of the attitude about the E, N, U axes, rad (the last is yaw)
+  double odom_scale = 1.0;          // wheel odometer scale factor
 };
 
 // Attitude of a state: roll about x, pitch about y, yaw about z (ZYX order) in deg, yaw counter-clockwise
@@ -180,17 +180,17 @@ struct Rejection {
 
 struct Status {
   bool initialized = false;
-  std::string diagnosis;          // why there is no solution yet; "initialised" once there is
-  bool init_timed_out = false;    // still not initialised init.max_wait_s after the first measurement
-  std::optional<Geodetic> origin;  // of w, once known
+  std::string diagnosis;                     // why there is no solution yet; "initialised" once there is
+  bool init_timed_out = false;               // still not initialised init.max_wait_s after the first measurement
+  std::optional<Geodetic> origin;            // of w, once known
   double first_time = 0.0, last_time = 0.0;  // of the measurements taken (0 before the first)
-  uint64_t accepted = 0;          // measurements taken
-  uint64_t reordered = 0;         // of them: arrived out of order within the window, sorted into place
-  uint64_t rejected = 0;          // refused by the session: late or invalid (in rejections, source "input")
-  uint64_t states = 0;            // states delivered
-  uint64_t states_dropped = 0;    // polling: dropped because the queue was full (oldest first)
-  uint64_t callback_errors = 0;   // state callbacks that threw
-  uint64_t watchdog_resets = 0;   // re-initialisations from GNSS after divergence, over all estimators
+  uint64_t accepted = 0;                     // measurements taken
+  uint64_t reordered = 0;                    // of them: arrived out of order within the window, sorted into place
+  uint64_t rejected = 0;                     // refused by the session: late or invalid (in rejections, source "input")
+  uint64_t states = 0;                       // states delivered
+  uint64_t states_dropped = 0;               // polling: dropped because the queue was full (oldest first)
+  uint64_t callback_errors = 0;              // state callbacks that threw
+  uint64_t watchdog_resets = 0;              // re-initialisations from GNSS after divergence, over all estimators
   std::vector<Rejection> rejections;
 };
 
@@ -198,7 +198,7 @@ struct Status {
 
 struct SessionOptions {
   Mode mode = Mode::kEskf;
-  bool geodetic = true;             // fill State::lla (about 0.2 µs a state)
+  bool geodetic = true;               // fill State::lla (about 0.2 µs a state)
   size_t max_queued_states = 100000;  // polling: the queue's bound
 };
 
@@ -258,7 +258,7 @@ class Session {
 struct ReadCounts {
   uint64_t lines = 0;
   uint64_t imu = 0, wheel = 0, gnss = 0, gnss_velocity = 0;  // records read
-  uint64_t skipped = 0;                                     // damaged lines skipped (input.on_error: skip)
+  uint64_t skipped = 0;                                      // damaged lines skipped (input.on_error: skip)
 };
 
 // A log in the gins format (DESIGN §3), with the damage policy of the config's input.* keys: damaged lines

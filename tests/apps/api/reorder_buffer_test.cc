@@ -50,7 +50,7 @@ TEST(ApiReorderBufferTest, OlderThanTheWindowIsLate) {
   std::vector<double> out;
   auto keep = [&](const LogRecord& r) { out.push_back(r.t()); };
   EXPECT_TRUE(buffer.Add(At(10.0, 0), keep));
-  EXPECT_TRUE(buffer.Add(At(9.5, 1), keep));   // exactly the window: sorted in
+  EXPECT_TRUE(buffer.Add(At(9.5, 1), keep));    // exactly the window: sorted in
   EXPECT_FALSE(buffer.Add(At(9.49, 2), keep));  // late
   EXPECT_TRUE(buffer.Add(At(10.6, 3), keep));
   EXPECT_EQ(out, (std::vector<double>{9.5, 10.0}));

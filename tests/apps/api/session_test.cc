@@ -67,8 +67,7 @@ TEST(ApiSessionTest, SampleGivesOneEskfStatePerImuSampleAfterInitialisation) {
   // In time order; a state may repeat the time of the one before (an update at that time supersedes it).
   for (size_t i = 1; i < states.size(); ++i) ASSERT_GE(states[i].t, states[i - 1].t);
   const State& last = states.back();
-  EXPECT_NEAR(std::hypot(last.q_wb[0], std::hypot(last.q_wb[1], std::hypot(last.q_wb[2], last.q_wb[3]))), 1.0,
-              1e-9);
+  EXPECT_NEAR(std::hypot(last.q_wb[0], std::hypot(last.q_wb[1], std::hypot(last.q_wb[2], last.q_wb[3]))), 1.0, 1e-9);
   EXPECT_GT(last.sigma_p[0], 0.0);
   EXPECT_LT(last.sigma_p[0], 1.0);
 }

@@ -81,6 +81,7 @@ inline constexpr auto kWheelKeys = [](auto& v, WheelOptions& o) {
 };
 
 inline constexpr auto kGravityKeys = [](auto& v, GravityOptions& o) {
+  v.Boolean("earth_rotation", o.earth_rotation);
   v.Choice("model", o.use_normal_gravity, Choices<bool>{{"normal", true}, {"fixed", false}});
   // Earth's surface gravity spans 9.76-9.84 m/s²; anything far outside is a typo, not a place.
   v.Number("magnitude_m_s2", o.magnitude, kNoUnit, Within(9.7, 9.9));

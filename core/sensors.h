@@ -68,7 +68,10 @@ struct WheelOptions {
 
 // gravity.*
 struct GravityOptions {
-  bool use_normal_gravity = true;   // gravity.model: normal (WGS84 at the origin) | fixed
+  // gravity.earth_rotation: the Earth turns under w (Earth rate, Coriolis, normal gravity by position:
+  // core/earth.h); false = the flat, non-rotating model.
+  bool earth_rotation = true;
+  bool use_normal_gravity = true;   // gravity.model: normal (WGS84) | fixed
   double magnitude = kStandardGravity;  // gravity.magnitude_m_s2 (model fixed)
 };
 

@@ -36,7 +36,8 @@ Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state)
 
 void Eskf::Initialize(const InitResult& init) {
   x_ = init.x0;
-  g_w_ = GravityWorld(init.g_norm);
+  earth_ = init.earth;
+  dg_w_.setZero();
   scale_ = 1.0;
   P_.setZero();
   P_.topLeftCorner<nav::kDim, nav::kDim>() = init.P0;
@@ -61,11 +62,13 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   if (held == nullptr) held = &*last_imu_;
   // Across an IMU gap, coast: no rotation, no acceleration (the held sample says nothing about the gap).
   const bool gap = t - last_imu_->t > options_.imu.max_gap;
-  const Vec3 omega = gap ? Vec3::Zero() : Vec3(held->gyro - x_.bg);
-  const Vec3 acc = gap ? Vec3(x_.q_wb.conjugate() * -g_w_) : Vec3(held->acc - x_.ba);
+  const Vec3 g_w = gravity();
+  const Vec3& rate_w = earth_.rate_w();
+  const Vec3 omega = gap ? Vec3(x_.q_wb.conjugate() * rate_w) : Vec3(held->gyro - x_.bg);
+  const Vec3 acc = gap ? Vec3(x_.q_wb.conjugate() * (2.0 * rate_w.cross(x_.v_w) - g_w)) : Vec3(held->acc - x_.ba);
   Kinematics k{x_.q_wb, x_.v_w, x_.p_wb};
   ImuStepJacobians J;
-  k = ImuStep(k, omega, acc, g_w_, dt, &J);
+  k = ImuStep(k, omega, acc, g_w, dt, &J, rate_w);
   a_w_ = (k.v - x_.v_w) / dt;
   x_.q_wb = k.q;
   x_.v_w = k.v;
@@ -147,7 +150,7 @@ bool Eskf::Update(const Eigen::Matrix<double, M, 1>& r, std::initializer_list<es
 
 void Eskf::Inject(const VecP& dx) {
   x_ = x_.Boxplus(dx.head<nav::kDim>());
-  g_w_ += eskf::SegmentOf<Block::kG>(dx);
+  dg_w_ += eskf::SegmentOf<Block::kG>(dx);
   scale_ += dx[eskf::kS];
   // Reset: the error is now zero about the corrected rotation; project the covariance accordingly
   // (right perturbation: ∂δθ⁺/∂δθ = I − ½[δθ]×).
@@ -165,7 +168,7 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
   Propagate(m.t);
   if (options_.watchdog.enabled) {
     const double max_sigma = options_.watchdog.max_position_sigma;
-    const bool finite = x_.AllFinite() && P_.allFinite() && g_w_.allFinite() && std::isfinite(scale_);
+    const bool finite = x_.AllFinite() && P_.allFinite() && dg_w_.allFinite() && std::isfinite(scale_);
     if (!finite || BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
       ResetFromGnss(m, finite ? "covariance" : "non_finite");
       prev_fix_ = m;
@@ -213,7 +216,7 @@ void Eskf::AddGvel(const GvelMeasurement& m) {
   if (!initialized_ || m.t < x_.t) return;
   Propagate(m.t);
   // The antenna's velocity includes the lever arm's turn: the body rate from the last IMU sample.
-  const Vec3 omega_b = last_imu_ ? Vec3(last_imu_->gyro - x_.bg) : Vec3::Zero();
+  const Vec3 omega_b = BodyRate();
   Eigen::Matrix<double, 3, 1> r;
   Eigen::Matrix<double, 3, 6> H6;  // (δv, δθ)
   const NavState& x = x_;
@@ -296,7 +299,8 @@ void Eskf::AddStandstill(const StandstillMeasurement& m) {
   const double sv = options_.standstill.velocity_sigma;
   Update<3>(r, {{Block::kV, Mat3::Identity()}}, Mat3::Identity() * sv * sv, gate_zupt_, &zupt_counts_, m.t);
   if (rate_usable) {
-    const Eigen::Matrix<double, 3, 1> rg = x_.bg - mean_gyro;
+    // Standing on the rotating Earth, the gyro reads its bias plus the Earth rate.
+    const Eigen::Matrix<double, 3, 1> rg = x_.bg + x_.q_wb.conjugate() * earth_.rate_w() - mean_gyro;
     const double sigma = 2.0 * options_.imu.gyro_noise_density / std::sqrt(T);
     Update<3>(rg, {{Block::kBg, Mat3::Identity()}}, Mat3::Identity() * sigma * sigma, gate_zero_rate_,
               &zupt_counts_, m.t);
@@ -316,7 +320,7 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
     x_.bg.setZero();
     x_.ba.setZero();
     x_.v_w.setZero();
-    g_w_ = GravityWorld(g_w_.allFinite() ? g_w_.norm() : kStandardGravity);
+    if (!dg_w_.allFinite()) dg_w_.setZero();
     if (!std::isfinite(scale_)) scale_ = 1.0;
     P_.setZero();
     P_.topLeftCorner<nav::kDim, nav::kDim>() = FallbackCovariance(options_);
@@ -358,7 +362,8 @@ nlohmann::json Eskf::Stats() const {
   j["wheel"] = wheel_counts_.ToJson();
   j["zero_velocity"] = zupt_counts_.ToJson();
   j["final_odom_scale"] = scale_;
-  j["final_gravity"] = {g_w_.x(), g_w_.y(), g_w_.z()};
+  const Vec3 g_w = gravity();
+  j["final_gravity"] = {g_w.x(), g_w.y(), g_w.z()};
   j["final_gyro_bias_deg_h"] = {x_.bg.x() * kRadToDeg * 3600, x_.bg.y() * kRadToDeg * 3600, x_.bg.z() * kRadToDeg * 3600};
   j["final_acc_bias_m_s2"] = {x_.ba.x(), x_.ba.y(), x_.ba.z()};
   return j;

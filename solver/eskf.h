@@ -53,7 +53,12 @@ class Eskf : public Estimator {
 
   const NavState& state() const { return x_; }
   const MatP& covariance() const { return P_; }
-  const Vec3& gravity() const { return g_w_; }
+  // Gravity in w at the current position: the Earth model's, plus the estimated correction (δg).
+  Vec3 gravity() const { return earth_.Gravity(x_.p_wb) + dg_w_; }
+  // The body's rate against w (rad/s) from the last IMU sample: gyro less bias less the Earth rate.
+  Vec3 BodyRate() const {
+    return last_imu_ ? Vec3(last_imu_->gyro - x_.bg - x_.q_wb.conjugate() * earth_.rate_w()) : Vec3::Zero();
+  }
   double odom_scale() const { return scale_; }
   StateEstimate Estimate() const;
 
@@ -79,7 +84,8 @@ class Eskf : public Estimator {
   StateCallback on_state_;
   bool initialized_ = false;
   NavState x_;
-  Vec3 g_w_ = Vec3::Zero();
+  EarthModel earth_;
+  Vec3 dg_w_ = Vec3::Zero();  // the estimated correction of the model's gravity
   double scale_ = 1.0;
   MatP P_ = MatP::Identity();
   std::optional<ImuSample> last_imu_;

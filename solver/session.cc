@@ -10,7 +10,6 @@ constexpr size_t kMaxPending = 100000;
 
 Session::Session(const EstimatorOptions& options) : options_(options) {
   if (options_.gnss.origin) frame_.emplace(*options_.gnss.origin);
-  if (!options_.gravity.use_normal_gravity) g_norm_ = options_.gravity.magnitude;
 }
 
 void Session::AddEstimator(std::unique_ptr<Estimator> estimator) { estimators_.push_back({std::move(estimator), {}}); }
@@ -31,8 +30,9 @@ void Session::Touch(double t) {
 
 void Session::EnsureInitializer() {
   if (init_ || !frame_) return;
-  if (g_norm_ == 0.0) g_norm_ = NormalGravity(frame_->origin().lat_deg, frame_->origin().alt_m);
-  init_ = std::make_unique<StaticInitializer>(options_, g_norm_);
+  earth_ = EarthModel::FromOptions(*frame_, options_.gravity);
+  g_norm_ = earth_.g_norm();
+  init_ = std::make_unique<StaticInitializer>(options_, earth_);
   standstill_ = std::make_unique<StandstillDetector>(options_.standstill, g_norm_, options_.wheel.interval);
   // Replay what arrived before the world frame existed, in time order.
   size_t i = 0, j = 0;
@@ -126,7 +126,9 @@ void Session::AddGnss(const GnssRecord& g) {
   // A logged σ is trusted down to a floor: a zero σ would make the fix infinitely certain.
   m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options_.gnss.min_sigma) : options_.gnss.sigma_enu;
   m.heading_valid = g.heading_valid;
-  m.yaw_G = CompassDegToEnuYaw(g.heading_deg);
+  // The receiver's heading is against true north at the antenna; w's north is the origin's.
+  m.yaw_G = g.heading_valid ? LocalYawToWorld(*frame_, *last_fix_geo_, CompassDegToEnuYaw(g.heading_deg))
+                            : CompassDegToEnuYaw(g.heading_deg);
   m.sigma_yaw = options_.gnss.heading_sigma;
   if (!initialized_) {
     init_->AddGnss(m);

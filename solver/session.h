@@ -64,6 +64,7 @@ class Session {
   EstimatorOptions options_;
   std::optional<LocalEnuFrame> frame_;
   double g_norm_ = 0.0;
+  EarthModel earth_;  // once the world frame exists
   std::unique_ptr<StaticInitializer> init_;
   bool initialized_ = false;
   struct Timed {

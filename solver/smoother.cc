@@ -49,7 +49,8 @@ void Smoother::Initialize(const InitResult& init) {
   po.enable_fast_removal = true;
   problem_ = std::make_unique<ceres::Problem>(po);
   window_.Reset(problem_.get());
-  g_w_ = GravityWorld(init.g_norm);
+  earth_ = init.earth;
+  g_w_ = earth_.Gravity(init.x0.p_wb);
 
   std::unique_ptr<Keyframe> first = window_.Make(init.x0.t, init.x0);
   first->block(BlockType::kScale)[0] = initial_scale_;
@@ -77,8 +78,8 @@ void Smoother::IntegrateTo(double t, const ImuSample* held) {
       // Across an IMU gap: no rotation and no acceleration, from the current estimate, with the
       // uncertainty of an unknown rate and acceleration held over the gap.
       coast.t = held->t;
-      coast.gyro = pred_.bg;
-      coast.acc = pred_.q_wb.conjugate() * -g_w_ + pred_.ba;
+      coast.gyro = pred_.bg + pred_.q_wb.conjugate() * earth_.rate_w();
+      coast.acc = pred_.q_wb.conjugate() * (2.0 * earth_.rate_w().cross(pred_.v_w) - g_w_) + pred_.ba;
       held = &coast;
       preint_->IntegrateGuess(coast.gyro, coast.acc, dt, kImuGapRateSigma, kImuGapAccSigma);
     } else {
@@ -86,10 +87,11 @@ void Smoother::IntegrateTo(double t, const ImuSample* held) {
     }
     interval_samples_.push_back({*held, dt});
     Kinematics k{pred_.q_wb, pred_.v_w, pred_.p_wb};
-    k = ImuStep(k, held->gyro - pred_.bg, held->acc - pred_.ba, g_w_, dt);
+    k = ImuStep(k, held->gyro - pred_.bg, held->acc - pred_.ba, g_w_, dt, nullptr, earth_.rate_w());
     pred_.q_wb = k.q;
     pred_.v_w = k.v;
     pred_.p_wb = k.p;
+    g_w_ = earth_.Gravity(pred_.p_wb);
   }
   pred_.t = t;
   t_now_ = t;
@@ -115,7 +117,11 @@ void Smoother::AddImu(const ImuSample& imu) {
 }
 
 ceres::ResidualBlockId Smoother::AddImuFactor(Keyframe& prev, Keyframe& kf) {
-  return window_.AddFactor(ImuFactor::Create(kf.preint, g_w_), nullptr,
+  // Gravity held over the interval: the model's at its middle (a metre of error there is 1e-6 m/s²).
+  ImuEarthTerms earth;
+  earth.g_w = earth_.Gravity(0.5 * (prev.State().p_wb + kf.State().p_wb));
+  earth.rate_w = earth_.rate_w();
+  return window_.AddFactor(ImuFactor::Create(kf.preint, earth), nullptr,
                            {{&prev, BlockType::kPose},
                             {&prev, BlockType::kVelocity},
                             {&prev, BlockType::kBias},
@@ -214,7 +220,8 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
     initial_scale_ = 1.0;
   }
   if (!have_cov) cov = FallbackCovariance(options_);
-  init.g_norm = g_w_.norm();
+  init.g_norm = earth_.g_norm();
+  init.earth = earth_;
   const bool have_velocity = ResetPositionFromFix(m, prev_fix_, options_, &init.x0, cov);
   // Tiny floors keep the prior invertible whatever the window's covariance was.
   cov = 0.5 * (cov + cov.transpose());
@@ -323,7 +330,12 @@ void Smoother::MarginalizeOldest() {
 
 void Smoother::OutputFinal(const Keyframe& kf, const Keyframe* next, const Mat15* cov) {
   last_scale_ = kf.block(BlockType::kScale)[0];
-  if (on_final_) EmitFinal(kf, next, interval_samples_, cov, g_w_, on_final_);
+  if (on_final_) {
+    ImuEarthTerms earth;
+    earth.g_w = earth_.Gravity(kf.State().p_wb);
+    earth.rate_w = earth_.rate_w();
+    EmitFinal(kf, next, interval_samples_, cov, earth, on_final_);
+  }
 }
 
 void Smoother::Finish() {

@@ -78,7 +78,8 @@ class Smoother : public Estimator {
 
   EstimatorOptions options_;
   StateCallback on_final_, on_online_;
-  Vec3 g_w_ = Vec3::Zero();
+  EarthModel earth_;
+  Vec3 g_w_ = Vec3::Zero();  // gravity at the newest prediction (the attachers read it)
   bool initialized_ = false;
 
   KeyframeStore window_;

@@ -59,7 +59,7 @@ bool OldestCovariance(KeyframeStore& store, Mat15* cov) {
 }
 
 void EmitFinal(const Keyframe& kf, const Keyframe* next, const std::vector<HeldImuSample>& tail, const Mat15* cov,
-               const Vec3& g_w, const StateCallback& on_final) {
+               const ImuEarthTerms& earth, const StateCallback& on_final) {
   const StateEstimate e = EstimateOf(kf, cov);
   on_final(e);
   // IMU-rate states to the next keyframe, propagated from this keyframe's final estimate.
@@ -71,7 +71,9 @@ void EmitFinal(const Keyframe& kf, const Keyframe* next, const std::vector<HeldI
   double t = e.x.t;
   for (size_t i = 0; i < steps.size(); ++i) {
     const HeldImuSample& step = steps[i];
-    if (!standing) k = ImuStep(k, step.sample.gyro - e.x.bg, step.sample.acc - e.x.ba, g_w, step.dt);
+    if (!standing) {
+      k = ImuStep(k, step.sample.gyro - e.x.bg, step.sample.acc - e.x.ba, earth.g_w, step.dt, nullptr, earth.rate_w);
+    }
     t += step.dt;
     if (next != nullptr && i + 1 == steps.size()) break;  // the next keyframe emits itself
     StateEstimate m = e;

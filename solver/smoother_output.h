@@ -26,6 +26,13 @@ bool OldestCovariance(KeyframeStore& store, Mat15* cov);
 // (excluded: it emits itself), propagated from this keyframe's final estimate through next's
 // steps_from_prev; without a next keyframe, through all of `tail` (the steps after the newest keyframe).
 void EmitFinal(const Keyframe& kf, const Keyframe* next, const std::vector<HeldImuSample>& tail, const Mat15* cov,
-               const Vec3& g_w, const StateCallback& on_final);
+               const ImuEarthTerms& earth, const StateCallback& on_final);
+// On the flat Earth with gravity g_w.
+inline void EmitFinal(const Keyframe& kf, const Keyframe* next, const std::vector<HeldImuSample>& tail,
+                      const Mat15* cov, const Vec3& g_w, const StateCallback& on_final) {
+  ImuEarthTerms earth;
+  earth.g_w = g_w;
+  EmitFinal(kf, next, tail, cov, earth, on_final);
+}
 
 }  // namespace gins

@@ -47,6 +47,14 @@ ceres::CostFunction* PreintAttachedFactor<Measurement>::Create(std::shared_ptr<c
                                                                const ImuEarthTerms& earth, Measurement measurement) {
   // The callers floor every σ and never attach over an empty interval: data cannot reach these.
   CHECK(preint != nullptr && preint->dt() > 0.0) << "PreintAttachedFactor over an empty preintegration";
+  return new PreintAttachedCostFunction<Measurement>(std::move(preint), earth, std::move(measurement));
+}
+
+template <class Measurement>
+ceres::CostFunction* PreintAttachedFactor<Measurement>::CreateAutoDiff(std::shared_ptr<const Preintegration> preint,
+                                                                       const ImuEarthTerms& earth,
+                                                                       Measurement measurement) {
+  CHECK(preint != nullptr && preint->dt() > 0.0) << "PreintAttachedFactor over an empty preintegration";
   return new ceres::AutoDiffCostFunction<PreintAttachedFactor<Measurement>, Measurement::kResidualDim,
                                          pose::kAmbient, 3, 6>(
       new PreintAttachedFactor<Measurement>(std::move(preint), earth, std::move(measurement)));

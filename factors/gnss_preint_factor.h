@@ -17,7 +17,7 @@ class GnssPreintFactor : public PreintAttachedFactor<GnssAtTime> {
       : PreintAttachedFactor<GnssAtTime>(std::move(preint), earth,
                                          GnssAtTime{z_w, sigma_w.cwiseInverse(), lever_b}) {}
 
-  // AutoDiffCostFunction<PreintAttachedFactor<GnssAtTime>, 3, 7, 3, 6>. Requires σ > 0.
+  // PreintAttachedCostFunction<GnssAtTime> (analytic Jacobians). Requires σ > 0.
   static ceres::CostFunction* Create(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth,
                                      const Vec3& z_w, const Vec3& sigma_w, const Vec3& lever_b);
 };

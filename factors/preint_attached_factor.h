@@ -11,6 +11,7 @@
 #pragma once
 
 #include <ceres/cost_function.h>
+#include <ceres/sized_cost_function.h>
 
 #include <memory>
 #include <utility>
@@ -75,16 +76,48 @@ class PreintAttachedFactor {
     return true;
   }
 
-  // AutoDiffCostFunction<PreintAttachedFactor, kResidualDim, 7, 3, 6> (factors/factories.cc). Requires a
+  // The production cost function: PreintAttachedCostFunction (analytic prediction Jacobians). Requires a
   // non-empty preintegration and σ > 0 (the measurement's inverse σ finite).
   static ceres::CostFunction* Create(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth,
                                      Measurement measurement);
+  // AutoDiffCostFunction<PreintAttachedFactor, kResidualDim, 7, 3, 6> of the same residual: the test oracle.
+  static ceres::CostFunction* CreateAutoDiff(std::shared_ptr<const Preintegration> preint,
+                                             const ImuEarthTerms& earth, Measurement measurement);
+
+  const Preintegration& preintegration() const { return *preint_; }
+  const ImuEarthTerms& earth() const { return earth_; }
+  const EarthTurns& turns() const { return turns_; }
+  const Measurement& measurement() const { return measurement_; }
 
  private:
   std::shared_ptr<const Preintegration> preint_;
   ImuEarthTerms earth_;
   EarthTurns turns_;
   Measurement measurement_;
+};
+
+// PreintAttachedFactor with analytic Jacobians of the prediction: the state at t as a function of state i and
+// its biases (core/preintegration.h: PredictKinematics), 9×15 in closed form in the right-perturbed tangents,
+//   δp_t = δp_i + A·T·δv_i − A·E3ᵀ·R_i·[Δp]×·δθ_i + A·E3ᵀ·R_i·(∂Δp/∂b)·δb
+//   δθ_t = ΔRᵀ·δθ_i + Jr(φ)·(∂ΔR/∂bg)·δbg
+//   δv_t = δv_i − E2ᵀ·R_i·[Δv]×·δθ_i + E2ᵀ·R_i·(∂Δv/∂b)·δb − 2[ω]×·(δp_t − δp_i)
+// (A = (I + [ω]×T)⁻¹, E_k the Earth's turns; identities for the flat Earth), times the measurement's own
+// Jacobian in (δp_t, δθ_t, δv_t) from autodiff with 9-dimensional Jets (cheap: the model is a few lines).
+// The pose block's tangent Jacobian is lifted to the ambient one as ImuCostFunction does.
+template <class Measurement>
+class PreintAttachedCostFunction final
+    : public ceres::SizedCostFunction<Measurement::kResidualDim, pose::kAmbient, 3, 6> {
+ public:
+  PreintAttachedCostFunction(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth,
+                             Measurement measurement)
+      : factor_(std::move(preint), earth, std::move(measurement)) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+  const PreintAttachedFactor<Measurement>& factor() const { return factor_; }
+
+ private:
+  PreintAttachedFactor<Measurement> factor_;
 };
 
 }  // namespace gins

@@ -59,13 +59,22 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
       session_(options_),
       reorder_(options_.input.reorder_window) {
   const Mode mode = session_options_.mode;
-  if (mode == Mode::kEskf || mode == Mode::kBoth) {
-    session_.AddEstimator(std::make_unique<Eskf>(options_, [this](const StateEstimate& e) { Emit(Stream::kEskf, e); }));
+  const bool all = mode == Mode::kAll;
+  if (mode == Mode::kEskf || mode == Mode::kBoth || all) {
+    ::gins::StateCallback rts;
+    if (all) rts = [this](const StateEstimate& e) { Emit(Stream::kEskfRts, e); };
+    session_.AddEstimator(std::make_unique<Eskf>(
+        options_, [this](const StateEstimate& e) { Emit(Stream::kEskf, e); }, std::move(rts)));
   }
-  if (mode == Mode::kSmoother || mode == Mode::kBoth) {
+  if (mode == Mode::kSmoother || mode == Mode::kBoth || mode == Mode::kBatch || all) {
+    // Batch alone: the window runs as the batch's forward pass, its own streams not delivered.
+    const bool window = mode != Mode::kBatch;
+    ::gins::StateCallback batch;
+    if (mode == Mode::kBatch || all) batch = [this](const StateEstimate& e) { Emit(Stream::kBatch, e); };
     session_.AddEstimator(std::make_unique<Smoother>(
-        options_, [this](const StateEstimate& e) { Emit(Stream::kSmoother, e); },
-        [this](const StateEstimate& e) { Emit(Stream::kSmootherOnline, e); }));
+        options_, window ? ::gins::StateCallback([this](const StateEstimate& e) { Emit(Stream::kSmoother, e); }) : nullptr,
+        window ? ::gins::StateCallback([this](const StateEstimate& e) { Emit(Stream::kSmootherOnline, e); }) : nullptr,
+        std::move(batch)));
   }
 }
 

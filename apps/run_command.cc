@@ -220,6 +220,7 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
   api::SessionOptions session_options;
   api::ParseMode(request.mode, &session_options.mode);
   session_options.geodetic = false;  // the outputs are in ENU
+  session_options.parallel = true;   // both and all: an estimator per core
   api::LogReader reader(request.log_path, config);
   std::error_code ec;
   std::filesystem::create_directories(request.out_dir, ec);

@@ -205,6 +205,10 @@ struct SessionOptions {
   Mode mode = Mode::kEskf;
   bool geodetic = true;               // fill State::lla (about 0.2 µs a state)
   size_t max_queued_states = 100000;  // polling: the queue's bound
+  // With more than one estimator (kBoth, kAll): each on a thread of its own. Every stream is the same, bit
+  // for bit; the callback (or the queue) is then fed from those threads, one call at a time, each stream
+  // in its own order; status() counts the other estimators' rejections once Finish has returned.
+  bool parallel = false;
 };
 
 using StateCallback = std::function<void(const State&)>;

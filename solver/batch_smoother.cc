@@ -196,16 +196,8 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
     }
     if (prior.cost) problem.AddResidualBlock(prior.cost.get(), nullptr, prior.Params());
 
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    if (!ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)) {
-      so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
-    }
-    so.linear_solver_ordering = ordering;
-    so.max_num_iterations = options_.batch.max_iterations;
-    so.function_tolerance = options_.batch.function_tolerance;
-    so.num_threads = options_.smoother.num_threads;
-    so.logging_type = ceres::SILENT;
+    const ceres::Solver::Options so = ChainSolverOptions(ordering, options_.batch.max_iterations,
+                                                         options_.batch.function_tolerance, options_.smoother.num_threads);
     ceres::Solver::Summary summary;
     ceres::Solve(so, &problem, &summary);
     stats_.iterations += static_cast<int>(summary.iterations.size());
@@ -221,13 +213,8 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
       for (int k = first + 1; k < last; ++k) {
         if (imu_factor_[k] == SIZE_MAX) continue;
         Keyframe& kf = *kfs_[k];
-        const double* bias = kfs_[k - 1]->block(BlockType::kBias);
-        const Vec3 bg = Eigen::Map<const Vec3>(bias), ba = Eigen::Map<const Vec3>(bias + 3);
-        const Preintegration& current = *kf.preint;
-        const double moved = std::sqrt((bg - current.bg_lin()).squaredNorm() + (ba - current.ba_lin()).squaredNorm());
-        if (!(moved > options_.smoother.bias_reintegrate_threshold)) continue;
-        auto fresh = std::make_shared<Preintegration>(current);
-        fresh->Reintegrate(bg, ba);
+        auto fresh = ReintegratedIfMoved(*kfs_[k - 1], *kf.preint, options_.smoother.bias_reintegrate_threshold);
+        if (!fresh) continue;
         ImuEarthTerms terms;
         terms.g_w = earth.Gravity(0.5 * (kfs_[k - 1]->State().p_wb + kf.State().p_wb));
         terms.rate_w = earth.rate_w();
@@ -309,16 +296,8 @@ void BatchSmoother::SolveBeforeSeam(const FactorLog& log, int first, int seam, c
     problem.AddResidualBlock(lf.cost.get(), const_cast<ceres::LossFunction*>(lf.loss), params);
   }
   if (prior.cost) problem.AddResidualBlock(prior.cost.get(), nullptr, prior.Params());
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  if (!ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)) {
-    so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
-  }
-  so.linear_solver_ordering = ordering;
-  so.max_num_iterations = options_.batch.max_iterations;
-  so.function_tolerance = options_.batch.function_tolerance;
-  so.num_threads = options_.smoother.num_threads;
-  so.logging_type = ceres::SILENT;
+  const ceres::Solver::Options so = ChainSolverOptions(ordering, options_.batch.max_iterations,
+                                                       options_.batch.function_tolerance, options_.smoother.num_threads);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
   stats_.iterations += static_cast<int>(summary.iterations.size());

@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "factors/bias_rw_factor.h"
@@ -99,6 +100,32 @@ void Keyframe::SetState(const NavState& x) {
   for (const BlockSpec& spec : kBlockSpecs) {
     if (spec.from_nav != nullptr) spec.from_nav(x, block(spec.type));
   }
+}
+
+std::shared_ptr<Preintegration> ReintegratedIfMoved(const Keyframe& prev, const Preintegration& pre,
+                                                    double threshold) {
+  const double* bias = prev.block(BlockType::kBias);
+  const Vec3 bg = Eigen::Map<const Vec3>(bias), ba = Eigen::Map<const Vec3>(bias + 3);
+  const double moved = std::sqrt((bg - pre.bg_lin()).squaredNorm() + (ba - pre.ba_lin()).squaredNorm());
+  if (!(moved > threshold)) return nullptr;
+  auto fresh = std::make_shared<Preintegration>(pre);
+  fresh->Reintegrate(bg, ba);
+  return fresh;
+}
+
+ceres::Solver::Options ChainSolverOptions(std::shared_ptr<ceres::ParameterBlockOrdering> ordering, int max_iterations,
+                                          double function_tolerance, int num_threads) {
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  if (!ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)) {
+    so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
+  }
+  so.linear_solver_ordering = std::move(ordering);
+  so.max_num_iterations = max_iterations;
+  so.function_tolerance = function_tolerance;
+  so.num_threads = num_threads;
+  so.logging_type = ceres::SILENT;
+  return so;
 }
 
 KeyframeStore::KeyframeStore(const EstimatorOptions& options) : options_(options) {

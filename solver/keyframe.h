@@ -5,7 +5,9 @@
 // the keyframes is one row (and its enum value), not an edit wherever the blocks are listed.
 #pragma once
 
+#include <ceres/ordered_groups.h>
 #include <ceres/problem.h>
+#include <ceres/solver.h>
 
 #include <array>
 #include <cstdint>
@@ -139,6 +141,13 @@ struct Keyframe {
   void SetState(const NavState& x);  // the NavState blocks (not t)
 };
 
+// Solver options for a chain of keyframes: sparse normal Cholesky on SuiteSparse (Eigen's sparse Cholesky
+// when Ceres lacks it), eliminating in `ordering` (time order, one block after the other: no fill-in along
+// the chain, and the same order every run; Ceres's default ordering is a set of block addresses, so the
+// last bits of the solution would follow the heap's layout).
+ceres::Solver::Options ChainSolverOptions(std::shared_ptr<ceres::ParameterBlockOrdering> ordering, int max_iterations,
+                                          double function_tolerance, int num_threads);
+
 // One block of one keyframe, as a factor's parameter.
 struct BlockRef {
   Keyframe* kf;
@@ -146,6 +155,13 @@ struct BlockRef {
 };
 
 class FactorLog;
+
+// The IMU from prev to a keyframe integrated again at prev's bias estimate, when that moved further than
+// threshold (norm of δb, rad/s and m/s² together) from where `pre` was integrated; null otherwise (the
+// factor's first-order bias Jacobians cover the rest). A new object: live factors never see theirs change.
+std::shared_ptr<Preintegration> ReintegratedIfMoved(const Keyframe& prev, const Preintegration& pre,
+                                                    double threshold);
+
 
 // The window's keyframes, oldest first, and their blocks in a Ceres problem.
 class KeyframeStore {

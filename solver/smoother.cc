@@ -350,25 +350,19 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
 
 bool Smoother::Solve() {
   ceres::Solver::Options so;
-  so.linear_solver_type = options_.smoother.linear_solver == "sparse_normal_cholesky" ? ceres::SPARSE_NORMAL_CHOLESKY
-                                                                                      : ceres::DENSE_SCHUR;
-  if (so.linear_solver_type == ceres::SPARSE_NORMAL_CHOLESKY) {
-    // SuiteSparse when Ceres has it (Debian's does), Eigen's sparse Cholesky otherwise.
-    if (!ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)) {
-      so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
-    }
-    // Eliminate in time order, one block after the other: no fill-in along the chain, and the same order
-    // every run. Ceres's default ordering is a set of block addresses, so the last bits of the solution
-    // would follow the heap's layout.
+  if (options_.smoother.linear_solver == "sparse_normal_cholesky") {
     auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
     int group = 0;
     for (double* b : window_.EstimatedBlocks()) ordering->AddElementToGroup(b, group++);
-    so.linear_solver_ordering = ordering;
+    so = ChainSolverOptions(ordering, options_.smoother.max_iterations, options_.smoother.function_tolerance,
+                            options_.smoother.num_threads);
+  } else {
+    so.linear_solver_type = ceres::DENSE_SCHUR;
+    so.max_num_iterations = options_.smoother.max_iterations;
+    so.function_tolerance = options_.smoother.function_tolerance;
+    so.num_threads = options_.smoother.num_threads;
+    so.logging_type = ceres::SILENT;
   }
-  so.max_num_iterations = options_.smoother.max_iterations;
-  so.function_tolerance = options_.smoother.function_tolerance;
-  so.num_threads = options_.smoother.num_threads;
-  so.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(so, problem_.get(), &summary);
   iterations_ += summary.iterations.size();
@@ -412,13 +406,8 @@ void Smoother::ReintegrateIfNeeded() {
     Keyframe& prev = window_[i - 1];
     Keyframe& kf = window_[i];
     if (kf.imu_id == nullptr) continue;
-    const double* bias = prev.block(BlockType::kBias);
-    const Vec3 bg = Eigen::Map<const Vec3>(bias), ba = Eigen::Map<const Vec3>(bias + 3);
-    const double moved = std::sqrt((bg - kf.preint->bg_lin()).squaredNorm() + (ba - kf.preint->ba_lin()).squaredNorm());
-    if (moved <= options_.smoother.bias_reintegrate_threshold) continue;
-    // A new preintegration (live factors must never see theirs change).
-    auto fresh = std::make_shared<Preintegration>(*kf.preint);
-    fresh->Reintegrate(bg, ba);
+    auto fresh = ReintegratedIfMoved(prev, *kf.preint, options_.smoother.bias_reintegrate_threshold);
+    if (!fresh) continue;
     problem_->RemoveResidualBlock(kf.imu_id);
     if (factor_log_) factor_log_->Deactivate(kf.imu_log_index);
     kf.preint = fresh;

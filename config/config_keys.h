@@ -89,14 +89,9 @@ inline constexpr auto kGravityKeys = [](auto& v, GravityOptions& o) {
 
 inline constexpr auto kInitKeys = [](auto& v, InitOptions& o) {
   v.Number("static_duration_s", o.static_duration, kNoUnit, Positive());
-  v.Number("max_gyro_std_deg_s", o.max_gyro_std, kDeg, Positive());
-  v.Number("max_acc_std_m_s2", o.max_acc_std, kNoUnit, Positive());
   v.Number("max_wait_s", o.max_wait, kNoUnit, Positive());
   v.Boolean("wait_for_heading", o.wait_for_heading);
-  v.Number("sigma_pos_m", o.sigma_pos, kNoUnit, Positive());
-  v.Number("sigma_vel_m_s", o.sigma_vel, kNoUnit, Positive());
-  v.Number("sigma_roll_pitch_deg", o.sigma_roll_pitch, kDeg, Positive());
-  v.Number("sigma_yaw_deg", o.sigma_yaw, kDeg, Positive());
+  v.Number("max_attitude_sigma_deg", o.max_attitude_sigma, kDeg, Within(0.01, 10.0));
 };
 
 inline constexpr auto kEskfKeys = [](auto& v, EskfOptions& o) {

@@ -1,5 +1,7 @@
 #include "solver/session.h"
 
+#include <cmath>
+
 #include "core/wheel_model.h"
 
 namespace gins {
@@ -91,14 +93,7 @@ void Session::AddOdom(const OdomRecord& o) {
     ++odom_ignored_;
     return;
   }
-  const WheelOptions& wo = options_.wheel;
-  WheelMeasurement w;
-  w.t = o.t;
-  w.speed = 0.5 * (WheelSpeedFromPulses(o.left_pulses, wo.radius, wo.pulses_per_rev, wo.interval) +
-                   WheelSpeedFromPulses(o.right_pulses, wo.radius, wo.pulses_per_rev, wo.interval));
-  w.sigma = wo.speed_sigma;
-  w.interval = wo.interval;
-  w.standstill = o.left_pulses == 0.0 && o.right_pulses == 0.0;
+  const WheelMeasurement w = WheelFromOdom(o);
   EnsureInitializer();
   if (standstill_) standstill_->AddWheel(w);
   if (!init_) {
@@ -112,6 +107,40 @@ void Session::AddOdom(const OdomRecord& o) {
   } else {
     Dispatch([&](Estimator& e) { e.AddWheel(w); });
   }
+}
+
+WheelMeasurement Session::WheelFromOdom(const OdomRecord& o) {
+  const WheelOptions& wo = options_.wheel;
+  // The pulses were counted since the previous record: its spacing is the interval, within half the
+  // nominal one either way (clock jitter, counted); a longer spacing means records were lost, and the
+  // record's own count then covers the nominal interval only (a gap, counted).
+  double interval = wo.interval;
+  if (last_odom_t_) {
+    const double spacing = o.t - *last_odom_t_;
+    if (spacing > 0.5 * wo.interval && spacing < 1.5 * wo.interval) {
+      interval = spacing;
+      if (std::abs(spacing - wo.interval) > 0.1 * wo.interval) ++wheel_jitter_;
+    } else if (spacing >= 1.5 * wo.interval) {
+      ++wheel_gaps_;
+    }
+  }
+  last_odom_t_ = o.t;
+  WheelMeasurement w;
+  w.t = o.t;
+  const double left = WheelSpeedFromPulses(o.left_pulses, wo.radius, wo.pulses_per_rev, interval);
+  const double right = WheelSpeedFromPulses(o.right_pulses, wo.radius, wo.pulses_per_rev, interval);
+  w.speed = 0.5 * (left + right);
+  w.sigma = wo.speed_sigma;
+  w.interval = interval;
+  w.distance = w.speed * interval;
+  w.standstill = o.left_pulses == 0.0 && o.right_pulses == 0.0;
+  if (wo.track > 0.0) {
+    // wheel.speed_sigma_m_s is the mean's σ: each wheel's is √2 larger, their difference's 2×.
+    w.has_yaw_rate = true;
+    w.yaw_rate = (right - left) / wo.track;
+    w.yaw_rate_sigma = 2.0 * wo.speed_sigma / wo.track;
+  }
+  return w;
 }
 
 void Session::AddGnss(const GnssRecord& g) {
@@ -188,6 +217,8 @@ nlohmann::json Session::Stats() const {
   nlohmann::json j;
   j["odom_ignored_wheel_disabled"] = odom_ignored_;
   j["gvel_unused"] = gvel_unused_;
+  j["wheel_interval_jitter"] = wheel_jitter_;
+  j["wheel_gaps"] = wheel_gaps_;
   j["dropped_before_first_fix"] = pending_dropped_;
   j["standstill_updates"] = standstill_sent_;
   // Simulated outages as absolute [begin, end) windows, and the log's own GNSS gaps.

@@ -81,6 +81,10 @@ class Session {
   // simulated outage or disabled are counted.
   std::optional<GeodeticPoint> last_fix_geo_;
   uint64_t gvel_unused_ = 0;
+  // Wheel records: the previous one's time (its spacing is the counting interval), jitter and gaps.
+  WheelMeasurement WheelFromOdom(const OdomRecord& o);
+  std::optional<double> last_odom_t_;
+  uint64_t wheel_jitter_ = 0, wheel_gaps_ = 0;
   double first_t_ = -1.0, last_t_ = 0.0;
 
   // Standstill detection (core/standstill_detector.h), fed from the initialiser's start; after

@@ -22,6 +22,12 @@ bool LeadingCovariance(ceres::Problem* problem, const std::vector<double*>& bloc
 // Covariance of the oldest keyframe of the window, from all the information in the window.
 bool OldestCovariance(KeyframeStore& store, Mat15* cov);
 
+// Joint covariance of the estimated blocks of some keyframes of the window (indices, 0 = oldest), in
+// KeyframeStore::EstimatedTypes order, keyframe after keyframe, from all the information in the window.
+bool KeyframesCovariance(KeyframeStore& store, const std::vector<size_t>& keyframes, MatX* cov);
+// The same in NavState tangent order (15) for one keyframe's block-order covariance (scale left out).
+Mat15 NavCovariance(const std::vector<BlockType>& types, const MatX& block_cov);
+
 // The final stream of one keyframe: its estimate, then the IMU-rate states up to the next keyframe
 // (excluded: it emits itself), propagated from this keyframe's final estimate through next's
 // steps_from_prev; without a next keyframe, through all of `tail` (the steps after the newest keyframe).

@@ -34,7 +34,7 @@ constexpr double kMaxInflation = 100.0;
 // The preintegrated IMU from t0 to every measurement epoch.
 struct Snapshots {
   std::vector<PreintSnapshot> fix, gvel, wheel;
-  std::vector<Vec3> gvel_omega_b;  // gyro less bias at each GNSS velocity's epoch
+  std::vector<Vec3> fix_omega_b, gvel_omega_b;  // gyro less bias at each fix's and GNSS velocity's epoch
   std::unique_ptr<Preintegration> total;  // to the last epoch
 };
 
@@ -55,6 +55,7 @@ Snapshots Integrate(const AlignmentInput& in, const Vec3& bg, const Vec3& ba, co
   Snapshots s;
   s.fix.resize(in.fixes.size());
   s.gvel.resize(in.gvels.size());
+  s.fix_omega_b.resize(in.fixes.size(), Vec3::Zero());
   s.gvel_omega_b.resize(in.gvels.size(), Vec3::Zero());
   s.wheel.resize(in.wheels.size());
   s.total = std::make_unique<Preintegration>(bg, ba, imu.gyro_noise_density, imu.acc_noise_density);
@@ -67,7 +68,10 @@ Snapshots Integrate(const AlignmentInput& in, const Vec3& bg, const Vec3& ba, co
       tc = q.t;
     }
     const PreintSnapshot snap(pre);
-    if (q.kind == 0) s.fix[q.index] = snap;
+    if (q.kind == 0) {
+      s.fix[q.index] = snap;
+      s.fix_omega_b[q.index] = held.gyro - bg;
+    }
     if (q.kind == 1) {
       s.gvel[q.index] = snap;
       s.gvel_omega_b[q.index] = held.gyro - bg;
@@ -123,7 +127,7 @@ void BuildProblem(const FitContext& c, const Snapshots& s, const Quat& q_ref, do
       Add<1>(p, align::HeadingTerm{epoch, so.gnss.mount_yaw, m.yaw_G, 1.0 / m.sigma_yaw}, x, true);
     }
     if (c.nhc && s.fix[i].dt() > 0.0) {
-      Add<2>(p, align::NhcTerm{epoch, 1.0 / so.wheel.nhc_sigma}, x, true);
+      Add<2>(p, align::NhcTerm{epoch, s.fix_omega_b[i], so.wheel.lever_b, 1.0 / so.vehicle.nhc_sigma}, x, true);
     }
   }
   for (size_t i = 0; i < in.gvels.size(); ++i) {
@@ -376,14 +380,6 @@ Search SearchYaws(const FitContext& ctx, const std::vector<double>& yaws) {
   return out;
 }
 
-// The 99.9 % quantile of χ²(dof) for any dof (Wilson–Hilferty beyond the table of core/chi2.h).
-double Chi2Quantile999(int dof) {
-  if (dof <= 9) return Chi2Quantile(0.999, std::max(dof, 1));
-  constexpr double kZ = 3.0902;  // the standard normal's 99.9 % quantile
-  const double k = dof, c = 2.0 / (9.0 * k);
-  return k * std::pow(1.0 - c + kZ * std::sqrt(c), 3);
-}
-
 }  // namespace
 
 double ImuWindowForSigma(const ImuOptions& imu, double g_norm, double sigma_m, double min_s, double max_s) {
@@ -407,7 +403,7 @@ AlignmentFit Align(const AlignmentInput& in, const AlignmentOptions& options, co
     out.problem = "too few IMU samples or GNSS fixes";
     return out;
   }
-  FitContext ctx{&in, &options, ImuEarthTerms{}, options.sensors.wheel.nonholonomic};
+  FitContext ctx{&in, &options, ImuEarthTerms{}, options.sensors.vehicle.nonholonomic};
   Vec3 centroid = Vec3::Zero();
   for (const GnssMeasurement& f : in.fixes) centroid += f.p_w;
   ctx.earth.g_w = earth.Gravity(centroid / static_cast<double>(in.fixes.size()));
@@ -427,23 +423,10 @@ AlignmentFit Align(const AlignmentInput& in, const AlignmentOptions& options, co
     for (int k = 0; k < 4; ++k) yaws.push_back(WrapAngle(course + k * 0.5 * kPi));
   }
   Search search = SearchYaws(ctx, yaws);
+  out.nhc_used = ctx.nhc;
   if (!search.ok) {
     out.problem = "the fit did not converge";
     return out;
-  }
-  // A land vehicle moves along its x axis: without a heading, try that too (wheel.nhc_sigma_m_s) and keep
-  // it when the data agree (its χ² is larger by no more than the added residuals allow at 99.9 %).
-  if (!ctx.nhc && !out.heading_used && options.nhc_when_consistent) {
-    FitContext with_nhc = ctx;
-    with_nhc.nhc = true;
-    yaws.push_back(search.best.yaw);
-    Search s2 = SearchYaws(with_nhc, yaws);
-    if (s2.ok && s2.best.chi2 - search.best.chi2 <=
-                     Chi2Quantile999(s2.residuals - search.residuals)) {
-      search = std::move(s2);
-      ctx = with_nhc;
-      out.nhc_used = true;
-    }
   }
   Candidate& best = search.best;
   out.runner_up_delta_chi2 = std::numeric_limits<double>::infinity();

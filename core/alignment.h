@@ -3,12 +3,12 @@
 // align. A small Ceres problem over one 15-vector, the state at the window's first epoch t0
 // (core/alignment_terms.h), with every measurement of the window predicted through the IMU preintegrated
 // from t0: GNSS positions and velocities, dual-antenna headings, wheel speeds, a car's non-holonomic
-// constraint (wheel.nonholonomic), a standstill that ended at t0 (its mean IMU readings and zero velocity),
-// and the sensors' stated bias priors.
+// constraint (vehicle.nonholonomic, at the rear axle), a standstill that ended at t0 (its mean IMU readings
+// and zero velocity), and the sensors' stated bias priors.
 //
 // Roll and pitch come from gravity, compensated by the acceleration the GNSS track shows; yaw from the
 // headings, or from the horizontal accelerations the IMU and the GNSS track both see (and, for a car, from
-// the course). The cost is not convex in yaw: the fit starts from four yaws 90° apart about the GNSS course
+// the course through the non-holonomic constraint). The cost is not convex in yaw: the fit starts from four yaws 90° apart about the GNSS course
 // and keeps the best; the best other solution (forward against backward, a mirror image) tells how
 // ambiguous it is. σ's come from the fit's information (with the sensors' stated noise and bias priors),
 // inflated when the residuals are larger or more correlated in time than stated.
@@ -47,9 +47,6 @@ struct AlignmentInput {
 struct AlignmentOptions {
   SensorOptions sensors;
   double zero_velocity_sigma = 0.01;  // m/s, a standstill's velocity (standstill.velocity_sigma_m_s)
-  // Without sensors.wheel.nonholonomic and without a heading, also fit with the non-holonomic constraint
-  // (σ sensors.wheel.nhc_sigma) and keep that fit when the data agree with it.
-  bool nhc_when_consistent = true;
 };
 
 struct AlignmentFit {

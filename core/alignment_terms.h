@@ -139,14 +139,17 @@ struct WheelTerm {
   }
 };
 
-// A car's non-holonomic constraint (core/wheel_model.h): no lateral, no vertical body speed; 2 residuals.
+// A car's non-holonomic constraint at the rear-axle centre (core/wheel_model.h): no lateral and no vertical
+// speed there; omega_b is the body rate at the epoch. 2 residuals.
 struct NhcTerm {
   Epoch epoch;
+  Vec3 omega_b, lever_b;
   double inv_sigma = 1.0;
   template <typename T>
   bool operator()(const T* x, T* r) const {
     const PredictedKinematics<T> k = epoch.Predict(x);
-    Eigen::Map<Eigen::Matrix<T, 2, 1>>{r} = NonHolonomicModel::Residual<T>(k.q, k.v) * T(inv_sigma);
+    const Vec3T<T> v_a = AxleVelocity<T>(k.q, k.v, omega_b, lever_b);
+    Eigen::Map<Eigen::Matrix<T, 2, 1>>{r} = v_a.template tail<2>() * T(inv_sigma);
     return true;
   }
 };

@@ -19,6 +19,11 @@ constexpr double kAttemptInterval = 1.0;  // s
 constexpr size_t kMaxStandstillFixes = 50;
 // Another yaw must explain the window worse by this χ²(1) quantile to rule it out.
 constexpr double kAmbiguityProbability = 0.9999;
+// The GNSS must rule out a zero speed at this probability before a fit is tried.
+constexpr double kMotionProbability = 0.999;
+// Over a full window a fit is accepted with a yaw 1-σ up to this: the iterated updates converge from tens of
+// degrees; far beyond, the linearised estimators would not.
+constexpr double kMaxSettledYawSigma = 30.0 * kDegToRad;
 // Floors of the initial covariance (1-σ): the estimators invert it.
 constexpr double kFloorPos = 1e-3, kFloorVel = 1e-3, kFloorAtt = 1e-5, kFloorBg = 1e-7, kFloorBa = 1e-5;
 
@@ -188,19 +193,18 @@ void Initializer::TryStandingWithHeading(const GnssMeasurement& fix) {
 }
 
 bool Initializer::Moved(const AlignmentInput& in) const {
-  // Yaw needs motion: a track longer than its noise, or a GNSS velocity well above its own.
-  const GnssMeasurement& first = in.fixes.front();
-  for (const GnssMeasurement& f : in.fixes) {
-    const double sigma = std::hypot(first.sigma_w.head<2>().norm(), f.sigma_w.head<2>().norm());
-    if ((f.p_w - first.p_w).head<2>().norm() > 3.0 * sigma) return true;
+  // Yaw needs motion: a speed that the GNSS velocities or a line through the fixes show to be non-zero
+  // (a slow rover on metre-level fixes needs a few seconds; a track longer than the fixes' σ, far more).
+  const double t0 = in.imu.front().t;
+  if (const std::optional<GnssSpeed> v = MeanGnssVelocity(in.gvels, t0)) {
+    if (GnssShowsMotion(*v, kMotionProbability)) return true;
   }
-  for (const GvelMeasurement& g : in.gvels) {
-    if (g.v_w.head<2>().norm() > 3.0 * g.sigma_w.head<2>().norm()) return true;
-  }
-  return false;
+  const std::optional<GnssSpeed> line = LineThroughFixes(in.fixes, t0);
+  return line && GnssShowsMotion(*line, kMotionProbability);
 }
 
-bool Initializer::BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bool* from_standstill) {
+bool Initializer::BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bool* from_standstill,
+                              bool* full) {
   // The longest window the IMU's noise allows for these fixes' σ (their median horizontal σ).
   std::vector<double> sigmas;
   for (const GnssMeasurement& f : fixes_) sigmas.push_back(f.sigma_w.head<2>().norm() / std::sqrt(2.0));
@@ -222,6 +226,9 @@ bool Initializer::BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bo
     return false;
   }
   t0 = in->imu.front().t;
+  // The window of motion is as long as it gets: from now on it slides, and the fit gets no better by
+  // waiting.
+  *full = fix.t - t0 >= length - kAttemptInterval;
   for (const GnssMeasurement& f : fixes_) {
     if (f.t >= t0 && f.t <= fix.t) in->fixes.push_back(f);
   }
@@ -246,31 +253,38 @@ bool Initializer::BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bo
 
 void Initializer::TryFit(const GnssMeasurement& fix) {
   AlignmentInput in;
-  bool from_standstill = false;
-  if (!BuildWindow(fix, &in, &from_standstill)) return;
+  bool from_standstill = false, full = false;
+  if (!BuildWindow(fix, &in, &from_standstill, &full)) return;
   last_attempt_ = fix.t;
   const AlignmentFit a = Align(in, align_options_, earth_);
   if (!a.solved) {
     last_problem_ = "moving, but the fit failed: " + a.problem;
     return;
   }
-  if (!Acceptable(a)) return;
+  if (!Acceptable(a, full)) return;
   Finish(a, fix, from_standstill ? last_standstill_ : std::nullopt);
 }
 
-bool Initializer::Acceptable(const AlignmentFit& a) {
+bool Initializer::Acceptable(const AlignmentFit& a, bool window_full) {
   const double max_att = options_.init.max_attitude_sigma;
   const double max_tilt = std::hypot(max_att, options_.imu.init_acc_bias_sigma / earth_.g_norm());
-  const double ambiguity = Chi2Quantile(kAmbiguityProbability, 1) * a.inflation;
+  const double chi2_1 = Chi2Quantile(kAmbiguityProbability, 1);
+  const double ambiguity = chi2_1 * a.inflation;
   std::ostringstream os;
   os << "moving; the last fit (" << a.fixes_used << " fixes) gives yaw σ " << Deg(a.yaw_sigma) << " deg (needs ≤ "
-     << Deg(max_att) << "), roll/pitch σ " << Deg(a.tilt_sigma) << " deg (needs ≤ " << Deg(max_tilt) << ")";
+     << Deg(max_att) << ", or ≤ " << Deg(kMaxSettledYawSigma) << " over a full window), roll/pitch σ "
+     << Deg(a.tilt_sigma) << " deg (needs ≤ " << Deg(max_tilt) << ")";
   if (std::isfinite(a.runner_up_delta_chi2)) {
     os << ", another yaw " << Deg(a.runner_up_yaw) << " deg is worse by χ² " << a.runner_up_delta_chi2
-       << " (needs > " << ambiguity << ")";
+       << " (needs > " << ambiguity << ", or > " << chi2_1 << " over a full window)";
   }
   last_problem_ = os.str();
-  return a.yaw_sigma <= max_att && a.tilt_sigma <= max_tilt && a.runner_up_delta_chi2 > ambiguity;
+  if (a.yaw_sigma <= max_att && a.tilt_sigma <= max_tilt && a.runner_up_delta_chi2 > ambiguity) return true;
+  // A slow vehicle on metre-level fixes may never give a precise yaw. Once the window is as long as it gets,
+  // the fit is as good as it will be: the estimators start from it with its σ, unless another yaw fits
+  // about as well (its χ² not inflated by the residuals' correlation here: the fit's σ covers that).
+  return window_full && a.yaw_sigma <= kMaxSettledYawSigma && a.tilt_sigma <= max_tilt &&
+         a.runner_up_delta_chi2 > chi2_1;
 }
 
 void Initializer::Finish(const AlignmentFit& a, const GnssMeasurement& fix, const std::optional<Standstill>& standstill) {

@@ -14,7 +14,9 @@
 // Acceptance (checked at most once a second of log, at a GNSS epoch): the fit's yaw σ is at most
 // init.max_attitude_sigma_deg; its roll/pitch σ at most that or what the accelerometer bias prior allows
 // (init_acc_bias_sigma / g), whichever is larger; and no other yaw explains the window nearly as well
-// (χ² difference above the 99.99 % quantile of χ²(1), scaled by the residuals' inflation). The window
+// (χ² difference above the 99.99 % quantile of χ²(1), scaled by the residuals' inflation). Once the window
+// is full (it slides from then on and the fit gets no better), a yaw σ up to 30° is accepted if no other
+// yaw is within that χ² quantile unscaled: a slow rover on metre-level fixes may never do better. The window
 // starts at the last standstill or slides: at most as long as the IMU's stated white noise allows for the
 // fixes' σ (ImuWindowForSigma, 5-60 s), and it restarts after an IMU gap.
 // The estimators start at the completing GNSS epoch with the fit's state and covariance there, having used
@@ -101,9 +103,10 @@ class Initializer {
   static void Summarize(Standstill* st);
   void Prune(double t);
   // The window for the fit ending at the fix; false (and last_problem_) when there is nothing to fit yet.
-  bool BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bool* from_standstill);
+  // *full: the window is as long as the IMU's noise allows (it slides from now on).
+  bool BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bool* from_standstill, bool* full);
   bool Moved(const AlignmentInput& in) const;
-  bool Acceptable(const AlignmentFit& a);
+  bool Acceptable(const AlignmentFit& a, bool window_full);
   void TryStandingWithHeading(const GnssMeasurement& fix);
   void TryFit(const GnssMeasurement& fix);
   void Finish(const AlignmentFit& a, const GnssMeasurement& fix, const std::optional<Standstill>& standstill);

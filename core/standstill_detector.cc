@@ -19,15 +19,18 @@ constexpr double kSpeedBoundSigmas = 3.0;
 // No fix for this long: the GNSS is silent (an outage) and witnesses nothing new.
 constexpr double kGnssSilence = 2.0;  // s
 
-// Whether a horizontal speed estimate v (m/s) with per-axis 1-σ s says standing, moving or cannot tell.
-StandstillDetector::State SpeedVerdict(const Vec2& v, double s, double max_speed) {
-  const double chi2 = v.squaredNorm() / (s * s);
-  if (chi2 > Chi2Quantile(kZeroSpeedProbability, 2)) return StandstillDetector::State::kMoving;
-  if (v.norm() + kSpeedBoundSigmas * s < max_speed) return StandstillDetector::State::kStanding;
+// Whether a horizontal speed estimate says standing, moving or cannot tell.
+StandstillDetector::State SpeedVerdict(const GnssSpeed& s, double max_speed) {
+  if (GnssShowsMotion(s, kZeroSpeedProbability)) return StandstillDetector::State::kMoving;
+  if (s.v.norm() + kSpeedBoundSigmas * s.sigma < max_speed) return StandstillDetector::State::kStanding;
   return StandstillDetector::State::kUndecided;
 }
 
 }  // namespace
+
+bool GnssShowsMotion(const GnssSpeed& s, double probability) {
+  return s.v.squaredNorm() > Chi2Quantile(probability, 2) * s.sigma * s.sigma;
+}
 
 const char* WitnessName(StandstillDetector::Witness w) {
   switch (w) {
@@ -107,46 +110,19 @@ bool StandstillDetector::WheelsPresent() const { return !wheels_.empty(); }
 
 StandstillDetector::State StandstillDetector::GnssVerdict(Witness* witness) const {
   // GNSS velocity: the mean over the quiet stretch against zero.
-  Vec2 sum = Vec2::Zero();
-  double var = 0.0;
-  int n = 0;
-  for (const GvelMeasurement& g : gvels_) {
-    if (g.t < quiet_since_) continue;
-    sum += g.v_w.head<2>();
-    var += g.sigma_w.head<2>().squaredNorm() / 2.0;
-    ++n;
-  }
-  if (n > 0) {
+  if (const std::optional<GnssSpeed> v = MeanGnssVelocity(gvels_, quiet_since_)) {
     *witness = Witness::kGnssVelocity;
-    return SpeedVerdict(sum / n, std::sqrt(var / n / n), options_.max_speed);
+    return SpeedVerdict(*v, options_.max_speed);
   }
-  // GNSS positions: a straight line through the fixes of the stretch, p = a + v·(t − t̄).
-  double t_mean = 0.0, var_p = 0.0;
-  Vec2 p_mean = Vec2::Zero();
-  for (const GnssMeasurement& f : fixes_) {
-    if (f.t < quiet_since_) continue;
-    t_mean += f.t;
-    p_mean += f.p_w.head<2>();
-    var_p += f.sigma_w.head<2>().squaredNorm() / 2.0;
-    ++n;
-  }
+  // GNSS positions: a straight line through the fixes of the stretch.
+  int n = 0;
+  for (const GnssMeasurement& f : fixes_) n += f.t >= quiet_since_ ? 1 : 0;
   // No GNSS lately (an outage): it cannot witness, however many fixes came early in the stretch.
   const bool silent = fixes_.empty() || t_ - fixes_.back().t > kGnssSilence;
   if (n == 0 || (n < 2 && silent)) return State::kQuietUnwitnessed;
   *witness = Witness::kGnssPosition;
-  if (n < 2) return State::kUndecided;
-  t_mean /= n;
-  p_mean /= n;
-  var_p /= n;
-  double stt = 0.0;
-  Vec2 stp = Vec2::Zero();
-  for (const GnssMeasurement& f : fixes_) {
-    if (f.t < quiet_since_) continue;
-    stt += (f.t - t_mean) * (f.t - t_mean);
-    stp += (f.t - t_mean) * (f.p_w.head<2>() - p_mean);
-  }
-  if (stt <= 0.0) return State::kUndecided;
-  return SpeedVerdict(stp / stt, std::sqrt(var_p / stt), options_.max_speed);
+  const std::optional<GnssSpeed> line = LineThroughFixes(fixes_, quiet_since_);
+  return line ? SpeedVerdict(*line, options_.max_speed) : State::kUndecided;
 }
 
 StandstillDetector::State StandstillDetector::Decide() const {

@@ -17,7 +17,9 @@
 // "unwitnessed" and the estimators check it against their own speed (standstill.max_speed_m_s).
 #pragma once
 
+#include <cmath>
 #include <deque>
+#include <optional>
 
 #include "core/conventions.h"
 #include "core/measurements.h"
@@ -81,5 +83,59 @@ class StandstillDetector {
 };
 
 const char* WitnessName(StandstillDetector::Witness w);
+
+// A horizontal velocity the GNSS shows, with its per-axis 1-σ.
+struct GnssSpeed {
+  Vec2 v = Vec2::Zero();
+  double sigma = 0.0;
+};
+
+// The mean of the GNSS velocities from t_from on (nullopt: none).
+template <typename Gvels>
+std::optional<GnssSpeed> MeanGnssVelocity(const Gvels& gvels, double t_from) {
+  Vec2 sum = Vec2::Zero();
+  double var = 0.0;
+  int n = 0;
+  for (const GvelMeasurement& g : gvels) {
+    if (g.t < t_from) continue;
+    sum += g.v_w.template head<2>();
+    var += g.sigma_w.template head<2>().squaredNorm() / 2.0;
+    ++n;
+  }
+  if (n == 0) return std::nullopt;
+  return GnssSpeed{sum / n, std::sqrt(var) / n};
+}
+
+// The velocity of a straight line through the fixes from t_from on, p = a + v·(t − t̄), least squares
+// (nullopt: fewer than two epochs).
+template <typename Fixes>
+std::optional<GnssSpeed> LineThroughFixes(const Fixes& fixes, double t_from) {
+  double t_mean = 0.0, var_p = 0.0;
+  Vec2 p_mean = Vec2::Zero();
+  int n = 0;
+  for (const GnssMeasurement& f : fixes) {
+    if (f.t < t_from) continue;
+    t_mean += f.t;
+    p_mean += f.p_w.template head<2>();
+    var_p += f.sigma_w.template head<2>().squaredNorm() / 2.0;
+    ++n;
+  }
+  if (n < 2) return std::nullopt;
+  t_mean /= n;
+  p_mean /= n;
+  var_p /= n;
+  double stt = 0.0;
+  Vec2 stp = Vec2::Zero();
+  for (const GnssMeasurement& f : fixes) {
+    if (f.t < t_from) continue;
+    stt += (f.t - t_mean) * (f.t - t_mean);
+    stp += (f.t - t_mean) * (f.p_w.template head<2>() - p_mean);
+  }
+  if (stt <= 0.0) return std::nullopt;
+  return GnssSpeed{stp / stt, std::sqrt(var_p / stt)};
+}
+
+// Whether the GNSS rules out a zero horizontal speed (χ², 2 dof, at `probability`).
+bool GnssShowsMotion(const GnssSpeed& s, double probability);
 
 }  // namespace gins

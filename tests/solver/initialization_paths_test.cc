@@ -195,7 +195,7 @@ TEST(InitializationPaths, ReversingAtTheStart) {
   sim.segments = {
       {3.0, 0.5, 0.0, 0.0, true},     // backing up
       {8.0, 0.0, 5.0 * kDeg, 0.0, true},  // reversing round a corner
-      {3.0, -0.5, 0.0, 0.0, true},    // stop
+      {4.0, -0.5, 0.0, 0.0, true},    // brake to a stop (the ramps leave 0.25 m/s after 3 s)
       {2.0, 0.0, 0.0, 0.0, false},
       {10.0, 1.0, 0.0, 0.0},          // off forward
       {20.0, 0.0, -4.0 * kDeg, 0.0},
@@ -226,6 +226,27 @@ TEST(InitializationPaths, CruiseIsNotAStandstill) {
       EXPECT_LT((o.run.eskf.front().x.v_w - o.run.truth[i].v_w).norm(), 0.5);
     }
   }
+}
+
+// A slow rover: 0.3 m/s on 10 Hz metre-level single-point fixes, no wheels, no heading; a standing start,
+// then a straight, a quarter turn and a straight. The yaw takes a full window of the slow track.
+TEST(InitializationPaths, SlowRoverSpp) {
+  SimOptions sim = SppDrive(30, 10.0);
+  sim.segments = {
+      {10.0, 0.0, 0.0, 0.0},         // standing
+      {3.5, 0.1, 0.0, 0.0},          // to 0.3 m/s
+      {40.0, 0.0, 0.0, 0.0},
+      {30.0, 0.0, 3.0 * kDeg, 0.0},  // quarter turn
+      {60.0, 0.0, 0.0, 0.0},
+  };
+  const Outcome o = RunAndScore(sim, SppOptions(sim), "slow rover, SPP 10 Hz");
+  EXPECT_EQ(o.run.stats["initialization"]["start"], "standstill");
+  ExpectCovered(o);
+  EXPECT_LT(o.init_after, 40.0);  // measured 30.2 s: a full window of the slow track
+  EXPECT_LT(o.eskf.rmse_h, 0.4);
+  EXPECT_LT(o.smoother.rmse_h, 0.25);
+  EXPECT_LT(o.eskf.max_yaw_deg, 2.0);
+  EXPECT_LT(o.smoother.max_yaw_deg, 2.0);
 }
 
 }  // namespace

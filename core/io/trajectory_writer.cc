@@ -75,25 +75,36 @@ TumWriter::TumWriter(const std::string& path, const std::string& mode, const Geo
   file_.Write(TrajectoryHeader(mode, origin));
 }
 
-void TumWriter::Add(const NavState& x) {
+const char kStatesCsvColumns[] =
+    "t,px,py,pz,vx,vy,vz,qw,qx,qy,qz,bgx,bgy,bgz,bax,bay,baz,"
+    "sigma_px,sigma_py,sigma_pz,sigma_vx,sigma_vy,sigma_vz,sigma_att_e,sigma_att_n,sigma_att_u,odom_scale\n";
+
+void WriteTumLine(FILE* f, const NavState& x) {
   Line l;
   l.Fixed(x.t, 6);
   for (int i = 0; i < 3; ++i) l.Char(' ').Fixed(x.p_wb[i], 5);
   l.Char(' ').Fixed(x.q_wb.x(), 9).Char(' ').Fixed(x.q_wb.y(), 9).Char(' ').Fixed(x.q_wb.z(), 9);
   l.Char(' ').Fixed(x.q_wb.w(), 9).Char('\n');
-  l.WriteTo(file_.stream());
+  l.WriteTo(f);
+}
+
+void TumWriter::Add(const NavState& x) {
+  WriteTumLine(file_.stream(), x);
   ++count_;
 }
 
 StatesCsvWriter::StatesCsvWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin)
     : file_(path) {
   file_.Write(TrajectoryHeader(mode, origin));
-  file_.Write(
-      "t,px,py,pz,vx,vy,vz,qw,qx,qy,qz,bgx,bgy,bgz,bax,bay,baz,"
-      "sigma_px,sigma_py,sigma_pz,sigma_vx,sigma_vy,sigma_vz,sigma_att_e,sigma_att_n,sigma_att_u,odom_scale\n");
+  file_.Write(kStatesCsvColumns);
 }
 
 void StatesCsvWriter::Add(const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa, double odom_scale) {
+  WriteStatesCsvLine(file_.stream(), x, sp, sv, sa, odom_scale);
+}
+
+void WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa,
+                        double odom_scale) {
   Line l;
   l.Fixed(x.t, 6);
   for (int i = 0; i < 3; ++i) l.Char(',').Fixed(x.p_wb[i], 5);
@@ -104,7 +115,7 @@ void StatesCsvWriter::Add(const NavState& x, const Vec3& sp, const Vec3& sv, con
     for (int i = 0; i < 3; ++i) l.Char(',').Sci((*v)[i], 4);
   }
   l.Char(',').Fixed(odom_scale, 6).Char('\n');
-  l.WriteTo(file_.stream());
+  l.WriteTo(f);
 }
 
 }  // namespace gins

@@ -32,6 +32,14 @@ class AtomicFile {
 // Comment line naming the mode and the world frame's origin (DESIGN §4).
 std::string TrajectoryHeader(const std::string& mode, const GeodeticPoint& origin);
 
+// One line of each format (with its '\n') to any stream: the writers below and `gins stream`'s stdout
+// print the same bytes.
+void WriteTumLine(FILE* f, const NavState& x);
+void WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att,
+                        double odom_scale);
+// The states CSV's column header line (after the TrajectoryHeader comment).
+extern const char kStatesCsvColumns[];
+
 // TUM trajectory: "t x y z qx qy qz qw" (body in w).
 class TumWriter {
  public:

@@ -1,7 +1,9 @@
 #include "solver/session.h"
 
 #include <cmath>
+#include <limits>
 
+#include "core/gnss_noise.h"
 #include "core/wheel_model.h"
 
 namespace gins {
@@ -154,6 +156,10 @@ void Session::AddGnss(const GnssRecord& g) {
   m.p_w = frame_->ToEnu({g.lat_deg, g.lon_deg, g.alt_m});
   // A logged σ is trusted down to a floor: a zero σ would make the fix infinitely certain.
   m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options_.gnss.min_sigma) : options_.gnss.sigma_enu;
+  // Successive fixes repeat much the same error: each is worth less than an independent one.
+  const double since_fix = last_fix_t_ ? g.t - *last_fix_t_ : std::numeric_limits<double>::infinity();
+  last_fix_t_ = g.t;
+  m.sigma_w *= CorrelatedNoiseInflation(since_fix, options_.gnss.error_correlation);
   m.heading_valid = g.heading_valid;
   // The receiver's heading is against true north at the antenna; w's north is the origin's.
   m.yaw_G = g.heading_valid ? LocalYawToWorld(*frame_, *last_fix_geo_, CompassDegToEnuYaw(g.heading_deg))

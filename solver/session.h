@@ -80,6 +80,7 @@ class Session {
   // Earth radius); before initialisation they go to the initialiser; those before the first fix, in a
   // simulated outage or disabled are counted.
   std::optional<GeodeticPoint> last_fix_geo_;
+  std::optional<double> last_fix_t_;  // the previous fix's time (gnss.error_correlation_s)
   uint64_t gvel_unused_ = 0;
   // Wheel records: the previous one's time (its spacing is the counting interval), jitter and gaps.
   WheelMeasurement WheelFromOdom(const OdomRecord& o);

@@ -226,8 +226,6 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
   std::filesystem::create_directories(request.out_dir, ec);
   if (ec) throw std::runtime_error(request.out_dir + ": cannot create output directory: " + ec.message());
 
-  api::Session session(config, session_options);
-  const Session& internal = api::internal::Access::session(session);
   bool truth_checked = false;
   Streams streams;
   std::array<OutputStream*, 5> by_stream{};  // indexed by api::Stream: no look-up per state
@@ -236,6 +234,9 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
   BatchPipe<std::pair<OutputStream*, api::State>> writer([](const std::pair<OutputStream*, api::State>& item) {
     item.first->Add(api::ToStateEstimate(item.second));
   });
+  // After what its callback uses: on an error the session (and its estimator threads) goes first.
+  api::Session session(config, session_options);
+  const Session& internal = api::internal::Access::session(session);
   // States arrive only after initialisation, when the world frame (and so the truth in it) exists.
   session.OnState([&](const api::State& state) {
     OutputStream*& out = by_stream[static_cast<size_t>(state.stream)];

@@ -19,6 +19,7 @@
 #include "factors/pose_manifold.h"
 #include "solver/imu_bridge.h"
 #include "solver/marginalizer.h"
+#include "solver/smoother_gate.h"
 #include "solver/smoother_output.h"
 
 namespace gins {
@@ -44,7 +45,8 @@ nlohmann::json BatchStats::ToJson() const {
           {"covariance_time_s", covariance_time_s}, {"band_keyframes", band_keyframes},
           {"covariance_ok", covariance_ok}, {"solves", solves}, {"reintegrations", reintegrations},
           {"keyframes_dropped", keyframes_dropped}, {"segments", segments},
-          {"marginalization_failures", marginalization_failures}};
+          {"marginalization_failures", marginalization_failures}, {"revisit_dropped", revisit_dropped},
+          {"revisit_restored", revisit_restored}};
 }
 
 BatchSmoother::BatchSmoother(const EstimatorOptions& options, std::vector<BlockType> estimated_types)
@@ -109,7 +111,7 @@ void BatchSmoother::Solve(FactorLog* log, const EarthModel& earth) {
   int w = 1;
   for (size_t i = 0; i < log->factors().size(); ++i) {
     const LoggedFactor& f = log->factors()[i];
-    if (!f.active) continue;
+    if (!f.active && !f.revisitable()) continue;
     FactorSpan span{i, n, -1};
     bool usable = true;
     for (const BlockRef& ref : f.blocks) {
@@ -125,7 +127,6 @@ void BatchSmoother::Solve(FactorLog* log, const EarthModel& earth) {
     w = std::max(w, span.hi - span.lo);
     factors_.push_back(span);
   }
-  stats_.factors = static_cast<int>(factors_.size());
   stats_.band_keyframes = w;
   // Each keyframe's IMU factor from the keyframe before it (to re-integrate at the batch's biases).
   imu_factor_.assign(n, SIZE_MAX);
@@ -173,7 +174,10 @@ void BatchSmoother::Solve(FactorLog* log, const EarthModel& earth) {
 
 int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int first, int last, int seam_from,
                                 int seam_to, const Prior& prior) {
-  const auto inside = [&](const FactorSpan& f) { return f.lo >= first && f.hi < last; };
+  const auto inside = [&](const FactorSpan& f) {
+    return f.lo >= first && f.hi < last && log->factors()[f.log_index].active;
+  };
+  bool revisited = false;
   for (int round = 0;; ++round) {
     ceres::Problem::Options po;
     po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // the log's and the prior's
@@ -234,7 +238,6 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
     }
     stats_.reintegrations += reintegrated;
     if (reintegrated == 0) {
-      stats_.final_cost += summary.final_cost;  // summed over the segments (their overlaps counted twice)
       const auto t1 = std::chrono::steady_clock::now();
       std::vector<FactorSpan> spans;
       for (const FactorSpan& f : factors_) {
@@ -243,6 +246,16 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
       if (prior.cost) spans.push_back({SIZE_MAX, prior.lo, prior.hi});
       std::vector<Mat15> cov;
       const bool ok = RecoverCovariances(&problem, spans, first, last, &cov);
+      stats_.covariance_time_s += Seconds(std::chrono::steady_clock::now() - t1);
+      // The window decided on each fix from one side; check them all again on the two-sided solution and
+      // its covariance, and solve once more if a decision changed.
+      if (ok && !revisited && Revisit(log, first, last, cov)) {
+        revisited = true;
+        continue;
+      }
+      revisited = true;
+      stats_.final_cost += summary.final_cost;  // summed over the segments (their overlaps counted twice)
+      stats_.factors += static_cast<int>(spans.size());
       int seam = last;
       if (seam_from < last) {
         // Among the keyframes whose position variance is within 25 % of the best, the one nearest the middle
@@ -264,7 +277,6 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
         covariances_[k] = cov[k - first];
         have_cov_[k] = true;
       }
-      stats_.covariance_time_s += Seconds(std::chrono::steady_clock::now() - t1);
       return seam;
     }
   }
@@ -291,6 +303,7 @@ void BatchSmoother::SolveBeforeSeam(const FactorLog& log, int first, int seam, c
   for (const FactorSpan& f : factors_) {
     if (f.lo < first || f.lo >= seam || f.hi >= end) continue;
     const LoggedFactor& lf = log.factors()[f.log_index];
+    if (!lf.active) continue;
     std::vector<double*> params;
     for (const BlockRef& ref : lf.blocks) params.push_back(ref.kf->block(ref.type));
     problem.AddResidualBlock(lf.cost.get(), const_cast<ceres::LossFunction*>(lf.loss), params);
@@ -311,6 +324,47 @@ void BatchSmoother::SolveBeforeSeam(const FactorLog& log, int first, int seam, c
   stats_.iterations += static_cast<int>(summary.iterations.size());
   stats_.usable = stats_.usable && summary.IsSolutionUsable();
   ++stats_.solves;
+}
+
+bool BatchSmoother::Revisit(FactorLog* log, int first, int last, const std::vector<Mat15>& cov) {
+  bool changed = false;
+  for (const FactorSpan& f : factors_) {
+    if (f.lo < first || f.hi >= last || f.lo != f.hi) continue;
+    const LoggedFactor& lf = log->factors()[f.log_index];
+    if (!lf.revisitable()) continue;
+    std::vector<const double*> params;
+    std::vector<BlockKind> kinds;
+    std::vector<BlockType> types;
+    for (const BlockRef& ref : lf.blocks) {
+      params.push_back(ref.kf->block(ref.type));
+      kinds.push_back(SpecOf(ref.type).kind);
+      types.push_back(ref.type);
+    }
+    // The keyframe's covariance over the factor's blocks (their tangents in the factor's order).
+    const std::vector<int> nav = NavIndexOfTangent(types);
+    MatX sigma(nav.size(), nav.size());
+    bool in_nav = true;
+    for (size_t r = 0; r < nav.size(); ++r) {
+      in_nav = in_nav && nav[r] >= 0;
+      for (size_t c = 0; c < nav.size(); ++c) sigma(r, c) = nav[r] >= 0 && nav[c] >= 0 ? cov[f.lo - first](nav[r], nav[c]) : 0.0;
+    }
+    if (!in_nav) continue;
+    // A used measurement is part of the solution: its residual's covariance is R − HPHᵀ; an unused one is
+    // predicted by it: R + HPHᵀ. The same χ² gate as the window's.
+    const FactorCheck check = CheckFactor(*lf.cost, params, kinds, sigma, /*posterior=*/lf.active);
+    if (!check.evaluated) continue;
+    const bool passes = check.chi2 <= lf.gate;
+    if (lf.active && !passes) {
+      log->SetActive(f.log_index, false);
+      ++stats_.revisit_dropped;
+      changed = true;
+    } else if (!lf.active && passes) {
+      log->SetActive(f.log_index, true);
+      ++stats_.revisit_restored;
+      changed = true;
+    }
+  }
+  return changed;
 }
 
 std::vector<double*> BatchSmoother::Prior::Params() const {
@@ -342,7 +396,7 @@ BatchSmoother::Prior BatchSmoother::MarginalPrior(const FactorLog& log, int firs
   // The factors by their first keyframe.
   std::vector<const FactorSpan*> by_lo;
   for (const FactorSpan& f : factors_) {
-    if (f.lo >= first && f.lo < seam) by_lo.push_back(&f);
+    if (f.lo >= first && f.lo < seam && log.factors()[f.log_index].active) by_lo.push_back(&f);
   }
   std::stable_sort(by_lo.begin(), by_lo.end(), [](const FactorSpan* a, const FactorSpan* b) { return a->lo < b->lo; });
   size_t next = 0;

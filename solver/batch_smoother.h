@@ -40,6 +40,8 @@ struct BatchStats {
   int keyframes_dropped = 0;  // not finite
   int segments = 0;
   int marginalization_failures = 0;  // at segment seams
+  int revisit_dropped = 0;   // fixes the window used that the two-sided solution rejects
+  int revisit_restored = 0;  // fixes the window rejected that the two-sided solution accepts
   int iterations = 0;
   int solves = 0;          // re-linearisation rounds
   int reintegrations = 0;  // IMU factors integrated again at the batch's biases
@@ -83,6 +85,9 @@ class BatchSmoother {
   // (last when seam_from is last: the final segment) and keeps the covariances of [first, seam).
   int SolveSegment(FactorLog* log, const EarthModel& earth, int first, int last, int seam_from, int seam_to,
                    const Prior& prior);
+  // Checks every revisitable measurement of [first, last) against the solution and its covariance (per
+  // keyframe, NavState order); true if one changed sides.
+  bool Revisit(FactorLog* log, int first, int last, const std::vector<Mat15>& cov);
   // Solves keyframes [first, seam) again with those from the seam on held where the later segment put them.
   void SolveBeforeSeam(const FactorLog& log, int first, int seam, const Prior& prior);
   Prior MarginalPrior(const FactorLog& log, int first, int seam, const Prior& previous);

@@ -21,7 +21,11 @@ struct LoggedFactor {
   std::shared_ptr<ceres::CostFunction> cost;
   const ceres::LossFunction* loss = nullptr;  // an attacher's: alive as long as the smoother
   std::vector<BlockRef> blocks;               // keyframes the log keeps alive
-  bool active = true;                         // false: the window replaced it (a re-integrated IMU factor)
+  bool active = true;  // used: false when the window replaced it (a re-integrated IMU factor) or rejected it
+  // A measurement whose acceptance the whole-log smoother checks again on its two-sided solution: the χ²
+  // gate it was checked with (+∞: not revisited). Rejected ones are logged inactive.
+  double gate = std::numeric_limits<double>::infinity();
+  bool revisitable() const { return gate < std::numeric_limits<double>::infinity(); }
 };
 
 class FactorLog {
@@ -31,6 +35,8 @@ class FactorLog {
     return factors_.size() - 1;
   }
   void Deactivate(size_t i) { factors_.at(i).active = false; }
+  void SetActive(size_t i, bool active) { factors_.at(i).active = active; }
+  void SetGate(size_t i, double gate) { factors_.at(i).gate = gate; }
   // The same factor on the same blocks, another cost (an IMU factor integrated again).
   void Replace(size_t i, std::shared_ptr<ceres::CostFunction> cost) { factors_.at(i).cost = std::move(cost); }
   // A keyframe that left the window (in time order). Its blocks keep the window's final estimate.

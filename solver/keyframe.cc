@@ -207,6 +207,22 @@ ceres::ResidualBlockId KeyframeStore::AddFactor(ceres::CostFunction* cost, ceres
   return AddLogged(shared, new FejCost(shared, std::move(fej)), loss, blocks);
 }
 
+ceres::ResidualBlockId KeyframeStore::AddMeasurement(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                                                     const std::vector<BlockRef>& blocks, double gate) {
+  const ceres::ResidualBlockId id = AddFactor(cost, loss, blocks);
+  if (log_ != nullptr) log_->SetGate(last_logged_, gate);
+  return id;
+}
+
+void KeyframeStore::LogRejected(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                                const std::vector<BlockRef>& blocks, double gate) {
+  std::shared_ptr<ceres::CostFunction> owned(cost);
+  if (log_ == nullptr) return;
+  LoggedFactor f{std::move(owned), loss, blocks, false};
+  f.gate = gate;
+  log_->Add(std::move(f));
+}
+
 ceres::ResidualBlockId KeyframeStore::AddLogged(std::shared_ptr<ceres::CostFunction> cost,
                                                 ceres::CostFunction* in_problem, ceres::LossFunction* loss,
                                                 const std::vector<BlockRef>& blocks) {

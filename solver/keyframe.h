@@ -196,6 +196,13 @@ class KeyframeStore {
   // block linearises at its keyframe's first estimate once the keyframe has one.
   ceres::ResidualBlockId AddFactor(ceres::CostFunction* cost, ceres::LossFunction* loss,
                                    const std::vector<BlockRef>& blocks);
+  // A measurement's factor, as AddFactor, that the whole-log smoother re-checks with gate (χ²).
+  ceres::ResidualBlockId AddMeasurement(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                                        const std::vector<BlockRef>& blocks, double gate);
+  // A measurement the window rejected: kept in the log (inactive) for the whole-log smoother to re-check,
+  // nothing added to the problem. Takes ownership of cost; without a log it is deleted.
+  void LogRejected(ceres::CostFunction* cost, ceres::LossFunction* loss, const std::vector<BlockRef>& blocks,
+                   double gate);
   // The covariance P0 (NavState tangent order) as a prior on kf's estimated blocks; a block outside
   // NavState gets its spec's prior_sigma, uncorrelated.
   ceres::ResidualBlockId AddPrior(Keyframe& kf, const Mat15& P0);

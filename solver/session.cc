@@ -90,8 +90,11 @@ struct Session::Worker {
   std::thread thread;        // last: starts once the members above exist
 };
 
-Session::~Session() {
+Session::~Session() { CancelThreads(); }
+
+void Session::CancelThreads() {
   for (auto& w : workers_) w->Stop(true);
+  workers_.clear();
 }
 
 template <typename M>

@@ -41,6 +41,9 @@ class Session {
   // order, so every stream is what the sequential run gives, bit for bit; their callbacks then come from
   // those threads (one thread per estimator, so one stream's states still come in order).
   void SetParallel(bool parallel) { parallel_ = parallel; }
+  // Stops the estimators' threads now, dropping what they have not run (a run abandoned on an error: the
+  // owner of their callbacks calls it before it goes away). The destructor does it too.
+  void CancelThreads();
 
   void AddImu(const ImuSample& raw);
   void AddOdom(const OdomRecord& odom);

@@ -38,7 +38,8 @@ Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, Stat
                last_imu_,
                [this](double t) { return PredictAt(t); },
                [this](double t) { return AnchorAt(t); },
-               [this]() -> const MatX* { return newest_two_cov_.size() > 0 ? &newest_two_cov_ : nullptr; }},
+               [this]() -> const MatX* { return newest_two_cov_.size() > 0 ? &newest_two_cov_ : nullptr; },
+               [this](double t) { return PartialAt(t); }},
       watchdog_(options.watchdog) {
   window_.SetLog(factor_log_.get());
   attachers_.push_back(std::make_unique<VehicleAttacher>(options_));
@@ -180,6 +181,13 @@ Anchor Smoother::AnchorAt(double t) {
     return {&kf, nullptr};
   }
   // A copy: the live preintegration goes on growing, a factor's must never change.
+  return {&newest, std::make_shared<const Preintegration>(*preint_)};
+}
+
+Anchor Smoother::PartialAt(double t) {
+  Keyframe& newest = window_.back();
+  IntegrateTo(t);
+  if (std::abs(t - newest.t) <= kSameEpoch || preint_->dt() <= 0.0) return {&newest, nullptr};
   return {&newest, std::make_shared<const Preintegration>(*preint_)};
 }
 

@@ -69,6 +69,7 @@ class Smoother : public Estimator {
   // The attachers' services (AttachContext): the prediction at t, and the keyframe policy's anchor.
   Prediction PredictAt(double t);
   Anchor AnchorAt(double t);
+  Anchor PartialAt(double t);
   // Solves the window if measurements joined it since the last solve.
   void SolveIfPending();
   // The joint covariance of the two newest keyframes (or the newest alone) after a solve.

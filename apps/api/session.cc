@@ -23,6 +23,8 @@ namespace gins::api {
 class Session::Impl {
  public:
   Impl(const Options& options, const SessionOptions& session_options);
+  // The estimators' threads stop before the members their callbacks use (Emit) go.
+  ~Impl() { session_.CancelThreads(); }
   Impl(const Impl&) = delete;  // the estimators' callbacks hold `this`
   Impl& operator=(const Impl&) = delete;
 

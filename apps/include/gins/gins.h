@@ -207,7 +207,8 @@ struct SessionOptions {
   size_t max_queued_states = 100000;  // polling: the queue's bound
   // With more than one estimator (kBoth, kAll): each on a thread of its own. Every stream is the same, bit
   // for bit; the callback (or the queue) is then fed from those threads, one call at a time, each stream
-  // in its own order; status() counts the other estimators' rejections once Finish has returned.
+  // in its own order; status() counts the other estimators' rejections once Finish has returned. What the
+  // callback uses must outlive the Session (destroying it stops the threads).
   bool parallel = false;
 };
 

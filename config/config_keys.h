@@ -56,6 +56,7 @@ inline constexpr auto kGnssKeys = [](auto& v, GnssOptions& o) {
   v.Number("mount_yaw_deg", o.mount_yaw, kDeg, Within(-360.0, 360.0));
   v.Vector3("sigma_m", o.sigma_enu, "[east, north, up]", Positive());
   v.Number("min_sigma_m", o.min_sigma, kNoUnit, Positive());
+  v.Number("error_correlation_s", o.error_correlation, kNoUnit, NonNegative());
   v.Number("heading_sigma_deg", o.heading_sigma, kDeg, Positive());
   v.Boolean("use_heading", o.use_heading);
   v.Number("gate_probability", o.gate_probability, kNoUnit, GateProbability());
@@ -96,14 +97,9 @@ inline constexpr auto kGravityKeys = [](auto& v, GravityOptions& o) {
 
 inline constexpr auto kInitKeys = [](auto& v, InitOptions& o) {
   v.Number("static_duration_s", o.static_duration, kNoUnit, Positive());
-  v.Number("max_gyro_std_deg_s", o.max_gyro_std, kDeg, Positive());
-  v.Number("max_acc_std_m_s2", o.max_acc_std, kNoUnit, Positive());
   v.Number("max_wait_s", o.max_wait, kNoUnit, Positive());
   v.Boolean("wait_for_heading", o.wait_for_heading);
-  v.Number("sigma_pos_m", o.sigma_pos, kNoUnit, Positive());
-  v.Number("sigma_vel_m_s", o.sigma_vel, kNoUnit, Positive());
-  v.Number("sigma_roll_pitch_deg", o.sigma_roll_pitch, kDeg, Positive());
-  v.Number("sigma_yaw_deg", o.sigma_yaw, kDeg, Positive());
+  v.Number("max_attitude_sigma_deg", o.max_attitude_sigma, kDeg, Within(0.01, 10.0));
 };
 
 inline constexpr auto kEskfKeys = [](auto& v, EskfOptions& o) {

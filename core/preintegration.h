@@ -161,18 +161,23 @@ void PredictedTransition(const NavState& x_i, const Preintegration& pre, double 
 
 // Preintegration::Predict written once for any scalar type (the factors that attach a measurement at a time
 // between keyframes differentiate it with Ceres's Jets): pose and velocity at j from state i and its biases,
-// first-order bias-corrected, with the Earth terms of ImuEarthTerms.
-template <typename T>
-PredictedKinematics<T> PredictKinematics(const Preintegration& pre, const ImuEarthTerms& earth,
+// first-order bias-corrected, with the Earth terms of ImuEarthTerms. Pre is a Preintegration or anything with
+// its accessors (dt, dq, dv, dp, bg_lin, ba_lin and the bias Jacobians: the alignment's snapshots).
+template <typename T, typename Pre>
+PredictedKinematics<T> PredictKinematics(const Pre& pre, const ImuEarthTerms& earth,
                                          const EarthTurns& turns, const Eigen::Matrix<T, 3, 1>& p_i,
                                          const Eigen::Quaternion<T>& q_i, const Eigen::Matrix<T, 3, 1>& v_i,
                                          const Eigen::Matrix<T, 3, 1>& bg, const Eigen::Matrix<T, 3, 1>& ba) {
   using Vec3T = Eigen::Matrix<T, 3, 1>;
-  const Vec3T dbg = bg - pre.bg_lin().cast<T>();
-  const Vec3T dba = ba - pre.ba_lin().cast<T>();
-  const Eigen::Quaternion<T> dq = pre.dq().cast<T>() * ExpQuat<T>(Vec3T(pre.dR_dbg().cast<T>() * dbg));
-  const Vec3T dv = pre.dv().cast<T>() + pre.dv_dbg().cast<T>() * dbg + pre.dv_dba().cast<T>() * dba;
-  const Vec3T dp = pre.dp().cast<T>() + pre.dp_dbg().cast<T>() * dbg + pre.dp_dba().cast<T>() * dba;
+  const Vec3 bg_lin = pre.bg_lin(), ba_lin = pre.ba_lin(), dv0 = pre.dv(), dp0 = pre.dp();
+  const Quat dq0 = pre.dq();
+  const Mat3 dR_dbg = pre.dR_dbg(), dv_dbg = pre.dv_dbg(), dv_dba = pre.dv_dba(), dp_dbg = pre.dp_dbg(),
+             dp_dba = pre.dp_dba();
+  const Vec3T dbg = bg - bg_lin.cast<T>();
+  const Vec3T dba = ba - ba_lin.cast<T>();
+  const Eigen::Quaternion<T> dq = dq0.cast<T>() * ExpQuat<T>(Vec3T(dR_dbg.cast<T>() * dbg));
+  const Vec3T dv = dv0.cast<T>() + dv_dbg.cast<T>() * dbg + dv_dba.cast<T>() * dba;
+  const Vec3T dp = dp0.cast<T>() + dp_dbg.cast<T>() * dbg + dp_dba.cast<T>() * dba;
   const T dt = T(pre.dt());
   const Vec3T g = earth.g_w.cast<T>();
   PredictedKinematics<T> out;

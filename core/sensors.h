@@ -33,6 +33,9 @@ struct GnssOptions {
   double mount_yaw = 12.06 * kDegToRad;    // gnss.mount_yaw_deg: yaw of the antenna baseline frame G in b
   Vec3 sigma_enu = Vec3(0.05, 0.05, 0.10);  // gnss.sigma_m [e, n, u]: used when a fix carries no σ
   double min_sigma = 0.005;                // gnss.min_sigma_m: floor for logged σ (a zero σ is not trusted)
+  // gnss.error_correlation_s: correlation time τ of the fixes' errors; each σ is inflated by
+  // √((1+ρ)/(1−ρ)), ρ = exp(−Δt/τ), Δt the spacing of the fixes (core/gnss_noise.h). 0: independent fixes.
+  double error_correlation = 0.0;
   double heading_sigma = 0.5 * kDegToRad;   // gnss.heading_sigma_deg
   bool use_heading = true;                 // gnss.use_heading
   double gate_probability = 0.9999;        // gnss.gate_probability: χ² gate on the innovation (0 = off)

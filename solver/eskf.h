@@ -25,7 +25,7 @@
 //   1-σ exceeds watchdog.max_position_sigma_m, or the state is not finite, the filter re-initialises from
 //   the current fix: position from the fix (1-σ: the fix's σ and 1 m), velocity from the last two fixes
 //   when they are at most 2 s apart (else kept; 1-σ 1 m/s), attitude and biases kept (yaw 1-σ at least
-//   init.sigma_yaw_deg); cross-covariances of position and velocity dropped. A glog WARNING and the summary
+//   2°); cross-covariances of position and velocity dropped. A glog WARNING and the summary
 //   (watchdog.resets: time, reason) say so.
 #pragma once
 

@@ -14,6 +14,7 @@ constexpr double kResetPosSigma = 1.0;        // m, added to the fix's σ
 constexpr double kResetVelSigma = 1.0;        // m/s, velocity from two fixes
 constexpr double kResetKeptVelSigma = 2.0;    // m/s, velocity kept from the diverged estimate
 constexpr double kResetMaxFixInterval = 2.0;  // s, longest interval of two fixes giving the velocity
+constexpr double kResetMinYawSigma = 2.0 * kDegToRad;  // a diverged estimate may have a wrong yaw
 }  // namespace
 
 bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
@@ -37,7 +38,7 @@ bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeas
   P.block<3, 3>(nav::kV, nav::kV).diagonal().setConstant(sigma_v * sigma_v);
   const Vec3 z_b = x->q_wb.conjugate() * Vec3::UnitZ();
   const double yaw_var = z_b.dot(P.block<3, 3>(nav::kTheta, nav::kTheta) * z_b);
-  const double min_yaw_var = options.init.sigma_yaw * options.init.sigma_yaw;
+  const double min_yaw_var = kResetMinYawSigma * kResetMinYawSigma;
   if (yaw_var < min_yaw_var) P.block<3, 3>(nav::kTheta, nav::kTheta) += (min_yaw_var - yaw_var) * z_b * z_b.transpose();
   return have_velocity;
 }

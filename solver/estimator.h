@@ -11,7 +11,7 @@
 
 #include "core/measurements.h"
 #include "core/nav_state.h"
-#include "core/static_init.h"
+#include "core/initializer.h"
 #include "solver/estimator_options.h"
 
 namespace gins {
@@ -122,7 +122,7 @@ Mat15 FallbackCovariance(const EstimatorOptions& options);
 
 // The watchdog's re-initialisation from a GNSS fix m, alike in both estimators: position from the fix
 // through the lever arm, velocity from the previous fix when it is recent (else kept), and both with a fresh
-// covariance, uncorrelated with the rest; the yaw variance is raised to at least init.sigma_yaw, since a
+// covariance, uncorrelated with the rest; the yaw variance is raised to at least (2°)², since a
 // diverged estimate may have a wrong yaw. P is the covariance in NavState tangent order (its first 15 rows
 // and columns; more, e.g. the ESKF's gravity and scale, are left but decorrelated from δp and δv).
 // Returns whether the velocity came from the fixes.

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "core/standstill_detector.h"
-#include "core/static_init.h"
+#include "core/initializer.h"
 
 namespace gins {
 
@@ -45,12 +45,12 @@ struct WatchdogOptions {
   double max_position_sigma = 100.0;  // watchdog.max_position_sigma_m: position 1-σ that counts as exploded
 };
 
-// Everything an estimator (and the session that feeds it) may read.
+// Everything an estimator (and the session that feeds it) may read (the standstill detector's options come
+// with the initialiser's).
 struct EstimatorOptions : InitializerOptions {
   EskfOptions eskf;
   SmootherOptions smoother;
   BatchOptions batch;
-  StandstillOptions standstill;
   WatchdogOptions watchdog;
 };
 

@@ -5,9 +5,11 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <thread>
 
+#include "core/gnss_noise.h"
 #include "core/wheel_model.h"
 
 namespace gins {
@@ -138,7 +140,7 @@ void Session::EnsureInitializer() {
   if (init_ || !frame_) return;
   earth_ = EarthModel::FromOptions(*frame_, options_.gravity);
   g_norm_ = earth_.g_norm();
-  init_ = std::make_unique<StaticInitializer>(options_, earth_);
+  init_ = std::make_unique<Initializer>(options_, earth_);
   standstill_ = std::make_unique<StandstillDetector>(options_.standstill, g_norm_, options_.wheel.interval);
   // Replay what arrived before the world frame existed, in time order.
   size_t i = 0, j = 0;
@@ -258,11 +260,16 @@ void Session::AddGnss(const GnssRecord& g) {
   m.p_w = frame_->ToEnu({g.lat_deg, g.lon_deg, g.alt_m});
   // A logged σ is trusted down to a floor: a zero σ would make the fix infinitely certain.
   m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options_.gnss.min_sigma) : options_.gnss.sigma_enu;
+  // Successive fixes repeat much the same error: each is worth less than an independent one.
+  const double since_fix = last_fix_t_ ? g.t - *last_fix_t_ : std::numeric_limits<double>::infinity();
+  last_fix_t_ = g.t;
+  m.sigma_w *= CorrelatedNoiseInflation(since_fix, options_.gnss.error_correlation);
   m.heading_valid = g.heading_valid;
   // The receiver's heading is against true north at the antenna; w's north is the origin's.
   m.yaw_G = g.heading_valid ? LocalYawToWorld(*frame_, *last_fix_geo_, CompassDegToEnuYaw(g.heading_deg))
                             : CompassDegToEnuYaw(g.heading_deg);
   m.sigma_yaw = options_.gnss.heading_sigma;
+  if (standstill_) standstill_->AddGnss(m);
   if (!initialized_) {
     init_->AddGnss(m);
     if (init_->done()) {
@@ -277,7 +284,7 @@ void Session::AddGnss(const GnssRecord& g) {
 void Session::AddGvel(const GvelRecord& g) {
   Touch(g.t);
   const bool in_outage = initialized_ && !outage_schedule_.empty() && outage_schedule_.Contains(g.t, first_t_);
-  if (!options_.gnss.use_velocity || !last_fix_geo_ || !initialized_ || in_outage) {
+  if (!options_.gnss.use_velocity || !last_fix_geo_ || !init_ || in_outage) {
     ++gvel_unused_;
     return;
   }
@@ -285,6 +292,11 @@ void Session::AddGvel(const GvelRecord& g) {
   m.t = g.t;
   m.v_w = frame_->RotationFromLocalEnu(*last_fix_geo_) * g.v_enu;
   m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options_.gnss.min_velocity_sigma) : options_.gnss.velocity_sigma_enu;
+  if (standstill_) standstill_->AddGvel(m);
+  if (!initialized_) {
+    init_->AddGvel(m);
+    return;
+  }
   Dispatch(&Estimator::AddGvel, m);
 }
 
@@ -343,6 +355,14 @@ nlohmann::json Session::Stats() const {
                            {"static_start", ir.static_start},
                            {"static_end", ir.static_end},
                            {"heading_source", ir.heading_source},
+                           {"start", ir.start},
+                           {"nonholonomic_fit", ir.nonholonomic_fit},
+                           {"standstill_witness", ir.standstill_witness},
+                           {"window_start", ir.window_start},
+                           {"yaw_sigma_deg", ir.yaw_sigma * kRadToDeg},
+                           {"roll_pitch_sigma_deg", ir.tilt_sigma * kRadToDeg},
+                           {"fit_chi2_per_dof", ir.chi2_per_dof},
+                           {"fit_inflation", ir.inflation},
                            {"gyro_bias_deg_h", {bg.x(), bg.y(), bg.z()}},
                            {"acc_bias_m_s2", {ir.x0.ba.x(), ir.x0.ba.y(), ir.x0.ba.z()}},
                            {"gyro_noise_deg_sqrt_h", ir.gyro_noise_density * kRadToDeg * 60.0},

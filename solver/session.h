@@ -1,6 +1,6 @@
 // A session turns raw log records into estimator input: axis mapping of the IMU, pulses to wheel speed,
-// geodetic fixes to the world frame (its origin fixed at the configured point or the first fix), static
-// initialisation, then the same time-ordered stream to every estimator. The runner feeds it from a log
+// geodetic fixes to the world frame (its origin fixed at the configured point or the first fix),
+// initialisation (core/initializer.h), then the same time-ordered stream to every estimator. The runner feeds it from a log
 // file; the end-to-end tests feed it from the simulator.
 #pragma once
 
@@ -18,7 +18,7 @@
 #include "core/eval/gnss_outages.h"
 #include "core/measurements.h"
 #include "core/standstill_detector.h"
-#include "core/static_init.h"
+#include "core/initializer.h"
 #include "solver/estimator.h"
 #include "solver/estimator_options.h"
 
@@ -81,7 +81,7 @@ class Session {
   std::optional<LocalEnuFrame> frame_;
   double g_norm_ = 0.0;
   EarthModel earth_;  // once the world frame exists
-  std::unique_ptr<StaticInitializer> init_;
+  std::unique_ptr<Initializer> init_;
   bool initialized_ = false;
   struct Timed {
     std::unique_ptr<Estimator> estimator;
@@ -93,8 +93,10 @@ class Session {
   std::vector<WheelMeasurement> pending_wheel_;
   uint64_t pending_dropped_ = 0, odom_ignored_ = 0;
   // GNSS velocities: the local frame of the last fix turns them into w (it differs from w by distance /
-  // Earth radius); those before the first fix or during initialisation, or disabled, are counted.
+  // Earth radius); before initialisation they go to the initialiser; those before the first fix, in a
+  // simulated outage or disabled are counted.
   std::optional<GeodeticPoint> last_fix_geo_;
+  std::optional<double> last_fix_t_;  // the previous fix's time (gnss.error_correlation_s)
   uint64_t gvel_unused_ = 0;
   // Wheel records: the previous one's time (its spacing is the counting interval), jitter and gaps.
   WheelMeasurement WheelFromOdom(const OdomRecord& o);

@@ -310,7 +310,7 @@ TEST_F(CliRun, GarbageLogWritesNothing) {
 // reading the whole log: nothing written.
 TEST_F(CliRun, LogThatNeverInitialisesWritesNothing) {
   ASSERT_EQ(sim_exit_, 0);
-  // The simulated log with every GNSS heading invalid while init waits for one.
+  // The simulated log with every GNSS heading invalid while init waits for one (init.wait_for_heading).
   std::string text;
   for (const auto& l : Lines(test::ReadFile(log_))) {
     std::string line = l;
@@ -328,8 +328,9 @@ TEST_F(CliRun, LogThatNeverInitialisesWritesNothing) {
   }
   const std::string log = dir_ + "/no_heading.txt";
   test::WriteFile(log, text);
-  const std::string out = dir_ + "/out_no_init";
-  EXPECT_EQ(RunCliInChild({"run", "--config", config_, "--log", log, "--out", out, "--mode", "both"}), 1);
+  const std::string out = dir_ + "/out_no_init", wait_config = dir_ + "/wait_for_heading.yaml";
+  test::WriteFile(wait_config, std::string(kConfig) + "init:\n  wait_for_heading: true\n");
+  EXPECT_EQ(RunCliInChild({"run", "--config", wait_config, "--log", log, "--out", out, "--mode", "both"}), 1);
   EXPECT_EQ(FilesIn(out), 0u);
 }
 

@@ -106,14 +106,9 @@ Comparison Compare(const Options& a, const Options& b) {
   GINS_FIELD(gravity.use_normal_gravity);
   GINS_FIELD(gravity.magnitude);
   GINS_FIELD(init.static_duration);
-  GINS_FIELD(init.max_gyro_std);
-  GINS_FIELD(init.max_acc_std);
   GINS_FIELD(init.max_wait);
   GINS_FIELD(init.wait_for_heading);
-  GINS_FIELD(init.sigma_pos);
-  GINS_FIELD(init.sigma_vel);
-  GINS_FIELD(init.sigma_roll_pitch);
-  GINS_FIELD(init.sigma_yaw);
+  GINS_FIELD(init.max_attitude_sigma);
   GINS_FIELD(eskf.estimate_gravity);
   GINS_FIELD(eskf.gravity_sigma);
   GINS_FIELD(smoother.window_size);
@@ -221,14 +216,9 @@ Options NonDefaultOptions() {
   o.gravity.use_normal_gravity = false;
   o.gravity.magnitude = 9.7936;
   o.init.static_duration = 5.0;
-  o.init.max_gyro_std = 0.2 * kDegToRad;
-  o.init.max_acc_std = 0.05;
   o.init.max_wait = 60.0;
-  o.init.wait_for_heading = false;
-  o.init.sigma_pos = 1.0;
-  o.init.sigma_vel = 0.01;
-  o.init.sigma_roll_pitch = 1.0 * kDegToRad;
-  o.init.sigma_yaw = 180.0 * kDegToRad;
+  o.init.wait_for_heading = true;
+  o.init.max_attitude_sigma = 2.5 * kDegToRad;
   o.eskf.estimate_gravity = false;
   o.eskf.gravity_sigma = 0.001;
   o.smoother.window_size = 20;
@@ -331,7 +321,7 @@ TEST(ConfigLoaderTest, WvuRoverConfigLoads) {
   EXPECT_EQ(o.wheel.radius, 0.11);
   EXPECT_EQ(o.wheel.pulses_per_rev, 1024.0);
   EXPECT_EQ(o.imu.R_b_imu, Mat3::Identity());
-  EXPECT_DOUBLE_EQ(o.init.sigma_yaw, kPi);
+  EXPECT_DOUBLE_EQ(o.init.static_duration, 2.0);
 }
 
 // The outage scenario is the defaults plus three 60 s simulated GNSS outages.
@@ -405,7 +395,7 @@ gnss:
   mount_yaw_deg: 90
   heading_sigma_deg: 2
 init:
-  max_gyro_std_deg_s: 1
+  max_attitude_sigma_deg: 1
 simulate:
   initial_heading_deg: 0
   segments: [{duration_s: 4, yaw_rate_deg_s: 9, grade_deg: -3}]
@@ -426,7 +416,7 @@ simulate:
   EXPECT_NEAR(o.simulate.gyro_turn_on_bias, 0.1 * kPi / 180.0, rel);
   EXPECT_NEAR(o.gnss.mount_yaw, kPi / 2.0, rel);
   EXPECT_NEAR(o.gnss.heading_sigma, 2.0 * kPi / 180.0, rel);
-  EXPECT_NEAR(o.init.max_gyro_std, kPi / 180.0, rel);
+  EXPECT_NEAR(o.init.max_attitude_sigma, kPi / 180.0, rel);
   ASSERT_EQ(o.simulate.segments.size(), 1u);
   EXPECT_NEAR(o.simulate.segments[0].yaw_rate, 9.0 * kPi / 180.0, rel);
   EXPECT_NEAR(o.simulate.segments[0].grade, -3.0 * kPi / 180.0, rel);

@@ -48,8 +48,6 @@ EstimatorOptions TacticalOptions(const SimOptions& sim, bool earth_rotation) {
   o.imu.init_gyro_bias_sigma = 2.0 * d / 3600.0;
   o.imu.init_acc_bias_sigma = 1e-3;
   o.gravity.earth_rotation = earth_rotation;
-  // Roll and pitch from gravity are as good as the accelerometer bias allows (2e-4 m/s² is 0.001°).
-  o.init.sigma_roll_pitch = 1e-4 * kDegToRad;
   return o;
 }
 

@@ -100,17 +100,21 @@ TEST(ApiSessionTest, FullPollQueueDropsTheOldest) {
   EXPECT_EQ(session.status().states_dropped, ReferenceEskf().size() - 10);
 }
 
-// GNSS fixes delivered 0.15 s late (after the IMU samples that follow them), as a live receiver does.
+// GNSS fixes delivered 0.15 s late (after the IMU samples that follow them), as a live receiver does,
+// from 30 s on: the first fixes arrive in time, so the session initialises even when the late ones are
+// refused (the initialiser needs a few fixes, not one at the end of the log).
 std::vector<Record> WithLateFixes(double delay, size_t* moved) {
+  constexpr double kInTimeFor = 30.0;  // s
   std::vector<Record> out;
   std::vector<Record> waiting;
   *moved = 0;
+  const double t_first = SampleRecords().front().t();
   for (const Record& r : SampleRecords()) {
     while (!waiting.empty() && r.t() > waiting.front().t() + delay) {
       out.push_back(waiting.front());
       waiting.erase(waiting.begin());
     }
-    if (r.type == Record::Type::kGnss) {
+    if (r.type == Record::Type::kGnss && r.t() >= t_first + kInTimeFor) {
       waiting.push_back(r);
     } else {
       out.push_back(r);

@@ -1,0 +1,338 @@
+#include "core/initializer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/chi2.h"
+#include "core/so3.h"
+
+namespace gins {
+namespace {
+
+// Bounds of the fit's window (ImuWindowForSigma between them).
+constexpr double kMinWindow = 5.0;   // s
+constexpr double kMaxWindow = 60.0;  // s
+// At most one fit per this much log time (each is a few small Ceres solves).
+constexpr double kAttemptInterval = 1.0;  // s
+// A standstill's fixes kept for the fit (the antenna stands: more say little).
+constexpr size_t kMaxStandstillFixes = 50;
+// Another yaw must explain the window worse by this χ²(1) quantile to rule it out.
+constexpr double kAmbiguityProbability = 0.9999;
+// The GNSS must rule out a zero speed at this probability before a fit is tried.
+constexpr double kMotionProbability = 0.999;
+// Over a full window a fit is accepted with a yaw 1-σ up to this: the iterated updates converge from tens of
+// degrees; far beyond, the linearised estimators would not.
+constexpr double kMaxSettledYawSigma = 30.0 * kDegToRad;
+// Floors of the initial covariance (1-σ): the estimators invert it.
+constexpr double kFloorPos = 1e-3, kFloorVel = 1e-3, kFloorAtt = 1e-5, kFloorBg = 1e-7, kFloorBa = 1e-5;
+
+std::string Deg(double rad) {
+  std::ostringstream os;
+  os.precision(2);
+  os << std::fixed << rad * kRadToDeg;
+  return os.str();
+}
+
+}  // namespace
+
+Initializer::Initializer(const InitializerOptions& options, const EarthModel& earth)
+    : options_(options),
+      earth_(earth),
+      detector_(
+          [&] {
+            StandstillOptions o = options.standstill;
+            o.enabled = true;  // the estimators' updates may be off; the static path still needs to know
+            o.window = options.init.static_duration;
+            return o;
+          }(),
+          earth.g_norm(), options.wheel.interval) {
+  align_options_.sensors = options;
+  align_options_.zero_velocity_sigma = options.standstill.velocity_sigma;
+}
+
+void Initializer::AddImu(const ImuSample& imu) {
+  if (done()) return;
+  if (first_time_ < 0.0) first_time_ = imu.t;
+  if (!imu_.empty() && imu.t - imu_.back().t > options_.imu.max_gap) {
+    // Nothing is integrated across an IMU gap: the window starts again after it.
+    imu_.clear();
+    standing_.reset();
+    last_standstill_.reset();
+  }
+  imu_.push_back(imu);
+  detector_.AddImu(imu);
+  TrackStandstill(imu);
+  Prune(imu.t);
+}
+
+void Initializer::AddWheel(const WheelMeasurement& wheel) {
+  if (done() || !options_.wheel.enabled) return;
+  wheels_.push_back(wheel);
+  detector_.AddWheel(wheel);
+}
+
+void Initializer::AddGvel(const GvelMeasurement& gvel) {
+  if (done()) return;
+  gvels_.push_back(gvel);
+  detector_.AddGvel(gvel);
+}
+
+void Initializer::Prune(double t) {
+  const double keep = kMaxWindow + 1.0;
+  while (!imu_.empty() && t - imu_.front().t > keep) imu_.pop_front();
+  while (!fixes_.empty() && t - fixes_.front().t > keep) fixes_.pop_front();
+  while (!gvels_.empty() && t - gvels_.front().t > keep) gvels_.pop_front();
+  while (!wheels_.empty() && t - wheels_.front().t > keep) wheels_.pop_front();
+}
+
+void Initializer::Summarize(Standstill* st) {
+  StaticSummary& m = st->summary;
+  const double n = std::max(1, m.n);
+  m.gyro_mean = st->gyro_sum / n;
+  m.acc_mean = st->acc_sum / n;
+  // Sums of squares are accurate enough here: the spreads only weigh the means (σ/√n), and at rest the
+  // accelerometer's spread is far above the rounding of g² (1e-15 relative).
+  m.gyro_std = (st->gyro_sq / n - m.gyro_mean.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
+  m.acc_std = (st->acc_sq / n - m.acc_mean.cwiseAbs2()).cwiseMax(0.0).cwiseSqrt();
+  m.mean_dt = n > 1 ? (m.t_end - m.t_start) / (n - 1.0) : 0.0;
+}
+
+void Initializer::Accumulate(const ImuSample& s, double sign) {
+  Standstill& st = *standing_;
+  st.gyro_sum += sign * s.gyro;
+  st.acc_sum += sign * s.acc;
+  st.gyro_sq += sign * s.gyro.cwiseAbs2();
+  st.acc_sq += sign * s.acc.cwiseAbs2();
+  st.summary.n += sign > 0.0 ? 1 : -1;
+}
+
+void Initializer::TrackStandstill(const ImuSample& imu) {
+  const bool standing = detector_.Decide() == StandstillDetector::State::kStanding;
+  if (standing && !standing_) {
+    // The quiet stretch the witness vouches for, from its start (its samples are still buffered).
+    standing_.emplace();
+    standing_->summary.t_start = std::max(detector_.quiet_since(), imu_.front().t);
+    standing_->witness = detector_.witness();
+    for (const ImuSample& s : imu_) {
+      if (s.t >= standing_->summary.t_start) Accumulate(s, 1.0);
+    }
+    standing_->summary.t_end = imu.t;
+    Summarize(&*standing_);
+    for (const GnssMeasurement& f : fixes_) {
+      if (f.t >= standing_->summary.t_start && standing_->fixes.size() < kMaxStandstillFixes) {
+        standing_->fixes.push_back(f);
+      }
+    }
+    return;
+  }
+  if (standing) {
+    Accumulate(imu, 1.0);
+    standing_->summary.t_end = imu.t;
+    Summarize(&*standing_);
+  } else if (standing_) {
+    CloseStandstill();
+  }
+}
+
+void Initializer::CloseStandstill() {
+  // A gentle start hides in the newest fifth of the detector's window for a while: leave that part out.
+  const double t_cut = standing_->summary.t_end - 0.2 * options_.init.static_duration;
+  double t_end = standing_->summary.t_start;
+  for (const ImuSample& s : imu_) {
+    if (s.t > t_cut && s.t <= standing_->summary.t_end) Accumulate(s, -1.0);
+    if (s.t <= t_cut) t_end = s.t;
+  }
+  Standstill st = std::move(*standing_);
+  standing_.reset();
+  if (t_end - st.summary.t_start < 0.5 * options_.init.static_duration || st.summary.n < 2) return;
+  st.summary.t_end = t_end;
+  Summarize(&st);
+  while (!st.fixes.empty() && st.fixes.back().t > t_end) st.fixes.pop_back();
+  last_standstill_ = std::move(st);
+}
+
+void Initializer::AddGnss(const GnssMeasurement& fix) {
+  if (done()) return;
+  fixes_.push_back(fix);
+  detector_.AddGnss(fix);
+  if (imu_.empty()) {
+    last_problem_ = "no IMU sample yet";
+    return;
+  }
+  if (standing_ && standing_->fixes.size() < kMaxStandstillFixes) standing_->fixes.push_back(fix);
+  const bool heading = options_.gnss.use_heading && fix.heading_valid;
+  if (standing_) {
+    if (heading) {
+      TryStandingWithHeading(fix);
+    } else {
+      last_problem_ = "standing still: yaw is not observable at rest; waiting for a valid dual-antenna heading "
+                      "or for the vehicle to move";
+    }
+    return;
+  }
+  if (options_.init.wait_for_heading && !heading) {
+    last_problem_ = "waiting for a valid dual-antenna heading (init.wait_for_heading: true)";
+    return;
+  }
+  if (!heading && fix.t - last_attempt_ < kAttemptInterval - 1e-6) return;
+  TryFit(fix);
+}
+
+void Initializer::TryStandingWithHeading(const GnssMeasurement& fix) {
+  AlignmentInput in;
+  in.imu = {imu_.back()};
+  in.fixes = standing_->fixes;
+  in.standstill = standing_->summary;
+  const AlignmentFit a = Align(in, align_options_, earth_);
+  if (!a.solved) {
+    last_problem_ = "standing still with a heading, but the fit failed: " + a.problem;
+    return;
+  }
+  Finish(a, fix, standing_);
+}
+
+bool Initializer::Moved(const AlignmentInput& in) const {
+  // Yaw needs motion: a speed that the GNSS velocities or a line through the fixes show to be non-zero
+  // (a slow rover on metre-level fixes needs a few seconds; a track longer than the fixes' σ, far more).
+  const double t0 = in.imu.front().t;
+  if (const std::optional<GnssSpeed> v = MeanGnssVelocity(in.gvels, t0)) {
+    if (GnssShowsMotion(*v, kMotionProbability)) return true;
+  }
+  const std::optional<GnssSpeed> line = LineThroughFixes(in.fixes, t0);
+  return line && GnssShowsMotion(*line, kMotionProbability);
+}
+
+bool Initializer::BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bool* from_standstill,
+                              bool* full) {
+  // The longest window the IMU's noise allows for these fixes' σ (their median horizontal σ).
+  std::vector<double> sigmas;
+  for (const GnssMeasurement& f : fixes_) sigmas.push_back(f.sigma_w.head<2>().norm() / std::sqrt(2.0));
+  std::nth_element(sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
+  const double length =
+      ImuWindowForSigma(options_.imu, earth_.g_norm(), sigmas[sigmas.size() / 2], kMinWindow, kMaxWindow);
+  double t0 = std::max(imu_.front().t, fix.t - length);
+  *from_standstill = last_standstill_ && last_standstill_->summary.t_end >= t0;
+  if (*from_standstill) {
+    t0 = last_standstill_->summary.t_end;
+    in->standstill = last_standstill_->summary;
+    in->fixes = last_standstill_->fixes;
+  }
+  for (const ImuSample& s : imu_) {
+    if (s.t >= t0 && s.t <= fix.t) in->imu.push_back(s);
+  }
+  if (in->imu.size() < 2) {
+    last_problem_ = "too few IMU samples before the fix";
+    return false;
+  }
+  t0 = in->imu.front().t;
+  // The window of motion is as long as it gets: from now on it slides, and the fit gets no better by
+  // waiting.
+  *full = fix.t - t0 >= length - kAttemptInterval;
+  for (const GnssMeasurement& f : fixes_) {
+    if (f.t >= t0 && f.t <= fix.t) in->fixes.push_back(f);
+  }
+  for (const GvelMeasurement& g : gvels_) {
+    if (g.t >= t0 && g.t <= fix.t) in->gvels.push_back(g);
+  }
+  for (const WheelMeasurement& w : wheels_) {
+    if (w.t - 0.5 * w.interval >= t0 && w.t <= fix.t) in->wheels.push_back(w);
+  }
+  if (in->fixes.size() < 3) {
+    last_problem_ = "waiting for more GNSS fixes";
+    return false;
+  }
+  // Without motion the fit knows no more than a standstill would (and a quiet IMU may become one).
+  if (!Moved(*in)) {
+    last_problem_ = "the GNSS shows no motion and no standstill is confirmed yet (IMU quiet for " +
+                    std::to_string(options_.init.static_duration) + " s and a witness)";
+    return false;
+  }
+  return true;
+}
+
+void Initializer::TryFit(const GnssMeasurement& fix) {
+  AlignmentInput in;
+  bool from_standstill = false, full = false;
+  if (!BuildWindow(fix, &in, &from_standstill, &full)) return;
+  last_attempt_ = fix.t;
+  const AlignmentFit a = Align(in, align_options_, earth_);
+  if (!a.solved) {
+    last_problem_ = "moving, but the fit failed: " + a.problem;
+    return;
+  }
+  if (!Acceptable(a, full)) return;
+  Finish(a, fix, from_standstill ? last_standstill_ : std::nullopt);
+}
+
+bool Initializer::Acceptable(const AlignmentFit& a, bool window_full) {
+  const double max_att = options_.init.max_attitude_sigma;
+  const double max_tilt = std::hypot(max_att, options_.imu.init_acc_bias_sigma / earth_.g_norm());
+  const double chi2_1 = Chi2Quantile(kAmbiguityProbability, 1);
+  const double ambiguity = chi2_1 * a.inflation;
+  std::ostringstream os;
+  os << "moving; the last fit (" << a.fixes_used << " fixes) gives yaw σ " << Deg(a.yaw_sigma) << " deg (needs ≤ "
+     << Deg(max_att) << ", or ≤ " << Deg(kMaxSettledYawSigma) << " over a full window), roll/pitch σ "
+     << Deg(a.tilt_sigma) << " deg (needs ≤ " << Deg(max_tilt) << ")";
+  if (std::isfinite(a.runner_up_delta_chi2)) {
+    os << ", another yaw " << Deg(a.runner_up_yaw) << " deg is worse by χ² " << a.runner_up_delta_chi2
+       << " (needs > " << ambiguity << ", or > " << chi2_1 << " over a full window)";
+  }
+  last_problem_ = os.str();
+  if (a.yaw_sigma <= max_att && a.tilt_sigma <= max_tilt && a.runner_up_delta_chi2 > ambiguity) return true;
+  // A slow vehicle on metre-level fixes may never give a precise yaw. Once the window is as long as it gets,
+  // the fit is as good as it will be: the estimators start from it with its σ, unless another yaw fits
+  // about as well (its χ² not inflated by the residuals' correlation here: the fit's σ covers that).
+  return window_full && a.yaw_sigma <= kMaxSettledYawSigma && a.tilt_sigma <= max_tilt &&
+         a.runner_up_delta_chi2 > chi2_1;
+}
+
+void Initializer::Finish(const AlignmentFit& a, const GnssMeasurement& fix, const std::optional<Standstill>& standstill) {
+  InitResult r;
+  r.x0 = a.x;
+  r.x0.t = fix.t;
+  Mat15 P = 0.5 * (a.P + a.P.transpose());
+  const double floors[] = {kFloorPos, kFloorVel, kFloorAtt, kFloorBg, kFloorBa};
+  for (int b = 0; b < 5; ++b) P.block<3, 3>(3 * b, 3 * b).diagonal().array() += floors[b] * floors[b];
+  r.P0 = P;
+  r.g_norm = earth_.g_norm();
+  r.earth = earth_;
+  r.heading_source = a.heading_used ? "dual_antenna" : "motion";
+  r.nonholonomic_fit = a.nhc_used;
+  r.start = standstill ? "standstill" : "moving";
+  if (standstill) {
+    const StaticSummary& s = standstill->summary;
+    r.static_start = s.t_start;
+    r.static_end = s.t_end;
+    r.gyro_std = s.gyro_std;
+    r.acc_std = s.acc_std;
+    r.gyro_noise_density = s.gyro_std.mean() * std::sqrt(s.mean_dt);
+    r.acc_noise_density = s.acc_std.mean() * std::sqrt(s.mean_dt);
+    r.standstill_witness = WitnessName(standstill->witness);
+  }
+  r.yaw_sigma = a.yaw_sigma;
+  r.tilt_sigma = a.tilt_sigma;
+  r.window_start = a.x0.t;
+  r.chi2_per_dof = a.chi2 / std::max(1, a.dof);
+  r.inflation = a.inflation;
+  r.runner_up_delta_chi2 = a.runner_up_delta_chi2;
+  result_ = r;
+}
+
+std::string Initializer::Diagnosis() const {
+  std::ostringstream os;
+  if (imu_.empty()) return "no IMU samples";
+  if (fixes_.empty()) return "no GNSS fix";
+  if (standing_) {
+    os << "standstill found at t=" << std::fixed << standing_->summary.t_start << " (witness "
+       << WitnessName(standing_->witness) << "), ";
+  } else if (last_standstill_) {
+    os << "standstill found at t=" << std::fixed << last_standstill_->summary.t_start << "-"
+       << last_standstill_->summary.t_end << ", ";
+  }
+  os << "initialisation did not complete: " << (last_problem_.empty() ? "no GNSS fix after it" : last_problem_);
+  if (options_.init.wait_for_heading) os << " (set init.wait_for_heading: false to take the yaw from the motion)";
+  return os.str();
+}
+
+}  // namespace gins

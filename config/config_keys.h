@@ -124,6 +124,7 @@ inline constexpr auto kBatchKeys = [](auto& v, BatchOptions& o) {
   v.Integer("max_iterations", o.max_iterations, 1);
   v.Number("function_tolerance", o.function_tolerance, kNoUnit, Within(1e-15, 0.1));
   v.Integer("max_relinearizations", o.max_relinearizations, 0);
+  v.Boolean("revisit_fixes", o.revisit_fixes);
   v.Integer("max_segment_keyframes", o.max_segment_keyframes, 16);
   v.Integer("segment_overlap_keyframes", o.segment_overlap_keyframes, 4);
 };

@@ -16,8 +16,6 @@ constexpr double kMaxGnssSpan = 30.0;  // s
 constexpr double kZeroSpeedProbability = 0.999;
 // ... and the speed's upper bound (estimate + this many σ) is below standstill.max_speed_m_s.
 constexpr double kSpeedBoundSigmas = 3.0;
-// No fix for this long: the GNSS is silent (an outage) and witnesses nothing new.
-constexpr double kGnssSilence = 2.0;  // s
 
 // Whether a horizontal speed estimate says standing, moving or cannot tell.
 StandstillDetector::State SpeedVerdict(const GnssSpeed& s, double max_speed) {
@@ -117,9 +115,10 @@ StandstillDetector::State StandstillDetector::GnssVerdict(Witness* witness) cons
   // GNSS positions: a straight line through the fixes of the stretch.
   int n = 0;
   for (const GnssMeasurement& f : fixes_) n += f.t >= quiet_since_ ? 1 : 0;
-  // No GNSS lately (an outage): it cannot witness, however many fixes came early in the stretch.
-  const bool silent = fixes_.empty() || t_ - fixes_.back().t > kGnssSilence;
-  if (n == 0 || (n < 2 && silent)) return State::kQuietUnwitnessed;
+  // Fewer than two fixes in the stretch (it began just now, or in an outage): the GNSS cannot witness
+  // (yet), so the estimators judge by their own speed, as in an outage without encoders. (The initialiser
+  // waits for a witnessed standstill.)
+  if (n < 2) return State::kQuietUnwitnessed;
   *witness = Witness::kGnssPosition;
   const std::optional<GnssSpeed> line = LineThroughFixes(fixes_, quiet_since_);
   return line ? SpeedVerdict(*line, options_.max_speed) : State::kUndecided;

@@ -236,7 +236,7 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
       stats_.covariance_time_s += Seconds(std::chrono::steady_clock::now() - t1);
       // The window decided on each fix from one side; check them all again on the two-sided solution and
       // its covariance, and solve once more if a decision changed.
-      if (ok && !revisited && Revisit(log, first, last, cov)) {
+      if (ok && !revisited && options_.batch.revisit_fixes && Revisit(log, first, last, cov)) {
         revisited = true;
         continue;
       }

@@ -34,6 +34,7 @@ struct BatchOptions {
   int max_iterations = 50;          // batch.max_iterations
   double function_tolerance = 1e-9;  // batch.function_tolerance: stop when |Δcost|/cost falls below
   int max_relinearizations = 2;     // batch.max_relinearizations: IMU re-integration rounds at the solution
+  bool revisit_fixes = true;        // batch.revisit_fixes: GNSS decisions checked again on the solution
   int max_segment_keyframes = 20000;     // batch.max_segment_keyframes: longer logs are solved in segments
   int segment_overlap_keyframes = 200;   // batch.segment_overlap_keyframes: the segments' overlap
 };

@@ -108,6 +108,7 @@ TEST(BatchEndToEnd, EqualsTheWindowWhenTheWindowSpansTheDrive) {
   options.smoother.function_tolerance = 1e-12;
   options.batch.function_tolerance = 1e-12;
   options.batch.max_relinearizations = 0;  // the window's own linearisation points
+  options.batch.revisit_fixes = false;     // and its own decisions
   options.smoother.bias_reintegrate_threshold = 1e9;  // the window never swaps a factor after its last solve
   const DriveRun run = test::RunDriveThroughSession(sim, options, nullptr, false, true, true);
   ASSERT_TRUE(run.initialized);

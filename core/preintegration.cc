@@ -56,11 +56,22 @@ void Preintegration::Step(const Sample& s) {
   const Mat9 A_cov = MulA<9>(J, cov_);
   const Eigen::Matrix<double, 9, 6> BQ = J.B.lazyProduct(Q);
   cov_ = MulA<9>(J, Mat9(A_cov.transpose())).transpose() + BQ.lazyProduct(J.B.transpose());
+  if (s.held_acc_sigma > 0.0) AddWhiteAcceleration(s.held_acc_sigma, s.dt);
   J_bias_ = MulA<6>(J, J_bias_) + J.B;
   delta_.dq = y.q;
   delta_.dv = y.v;
   delta_.dp = y.p;
   dt_total_ += s.dt;
+}
+
+void Preintegration::AddWhiteAcceleration(double sigma, double dt) {
+  // An acceleration of white noise with PSD q = σ²·dt over dt (the held part's velocity variance σ²·dt²):
+  // δv = ∫a, δp = ∫∫a, per axis [[dt³/3, dt²/2], [dt²/2, dt]]·q, isotropic so in any frame.
+  const double q = sigma * sigma * dt;
+  cov_.block<3, 3>(preint::kP, preint::kP).diagonal().array() += q * dt * dt * dt / 3.0;
+  cov_.block<3, 3>(preint::kP, preint::kV).diagonal().array() += q * dt * dt / 2.0;
+  cov_.block<3, 3>(preint::kV, preint::kP).diagonal().array() += q * dt * dt / 2.0;
+  cov_.block<3, 3>(preint::kV, preint::kV).diagonal().array() += q * dt;
 }
 
 void Preintegration::Reintegrate(const Vec3& bg_lin, const Vec3& ba_lin) {

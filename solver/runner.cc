@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -39,8 +40,9 @@ class OutputStream {
   }
 
   void Add(const StateEstimate& e) {
-    if (!e.x.AllFinite() || !e.sigma_p.allFinite()) {
-      ++non_finite_;  // never written: a NaN must not reach an output
+    if (!e.x.AllFinite() || !e.sigma_p.allFinite() || !e.sigma_v.allFinite() || !e.sigma_att.allFinite() ||
+        !std::isfinite(e.odom_scale)) {
+      ++non_finite_;  // never written (the writers refuse it too): a NaN must not reach an output
       return;
     }
     if (e.x.t <= last_t_) return;  // one state per time stamp, in time order

@@ -32,11 +32,15 @@ class AtomicFile {
 // Comment line naming the mode and the world frame's origin (DESIGN §4).
 std::string TrajectoryHeader(const std::string& mode, const GeodeticPoint& origin);
 
+// Neither writer ever writes a number that is not finite: a state with one is refused whole (Add returns
+// false, nothing written), so a NaN cannot reach an output file whatever the caller checked. Any finite value
+// fits its line, however large.
+
 // TUM trajectory: "t x y z qx qy qz qw" (body in w).
 class TumWriter {
  public:
   TumWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin);
-  void Add(const NavState& x);
+  bool Add(const NavState& x);
   void Commit() { file_.Commit(); }
   uint64_t count() const { return count_; }
 
@@ -49,7 +53,7 @@ class TumWriter {
 class StatesCsvWriter {
  public:
   StatesCsvWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin);
-  void Add(const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att, double odom_scale);
+  bool Add(const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att, double odom_scale);
   void Commit() { file_.Commit(); }
 
  private:

@@ -211,6 +211,10 @@ LineParse ParseValues(const Tokens& tokens, LogRecord::Type type, const char* co
     return Damaged(issue, kNonFinite, field + " is not finite");
   }
   if (!(v[0] > 0.0)) return Damaged(issue, kAbsurdValue, FieldValue(0, "t", v[0]) + ", time must be > 0");
+  if (!(v[0] < log_limits::kMaxTime)) {
+    return Damaged(issue, kAbsurdValue,
+                   FieldValue(0, "t", v[0]) + " s, beyond " + Num(log_limits::kMaxTime) + " s (not seconds?)");
+  }
   std::string absurd;
   switch (type) {
     case LogRecord::Type::kImu:

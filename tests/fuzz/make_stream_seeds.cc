@@ -1,14 +1,18 @@
 // Writes the stream fuzzer's seeds (tests/fuzz/corpus/stream/) from slices of a gins log, encoded in the
 // byte format of stream_format.h, plus a few made of the format's vehicle operations. Built with the fuzzers:
 //   build-fuzz/tests/fuzz/make_stream_seeds data/sample/log.txt.gz tests/fuzz/corpus/stream
+// and the other way, an input (a seed, a crash file) as a log and a config that `gins run` takes:
+//   build-fuzz/tests/fuzz/make_stream_seeds --to-log INPUT OUT_DIR   (writes OUT_DIR/log.txt, config.yaml)
 // Each slice starts with the log's first seconds (its standstill, so the estimators initialise) and may go
 // on from a later time after a gap; the decoder's times then differ from the log's by rounding only.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
+#include "config/config_loader.h"
 #include "fuzz/stream_format.h"
 
 namespace gins::fuzz {
@@ -157,13 +161,33 @@ std::vector<uint8_t> Slice(const std::vector<LogRecord>& log, uint8_t h1, double
   return e.bytes();
 }
 
+// The input's records as OUT_DIR/log.txt and its options as OUT_DIR/config.yaml.
+int ToLog(const std::string& input, const std::string& dir) {
+  std::ifstream in(input, std::ios::binary);
+  const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  StreamDecoder decoder(bytes.data(), bytes.size());
+  Options options;
+  static_cast<EstimatorOptions&>(options) = decoder.options();
+  std::ofstream(dir + "/config.yaml") << OptionsToYaml(options);
+  std::ofstream log(dir + "/log.txt");
+  LogRecord r;
+  size_t n = 0;
+  while (decoder.Next(&r)) {
+    log << ToLogLine(r) << '\n';
+    ++n;
+  }
+  std::printf("%s: %zu records -> %s/log.txt, %s/config.yaml\n", input.c_str(), n, dir.c_str(), dir.c_str());
+  return 0;
+}
+
 }  // namespace
 }  // namespace gins::fuzz
 
 int main(int argc, char** argv) {
   using gins::fuzz::Slice;
+  if (argc == 4 && std::string(argv[1]) == "--to-log") return gins::fuzz::ToLog(argv[2], argv[3]);
   if (argc != 3) {
-    std::fprintf(stderr, "usage: make_stream_seeds LOG OUT_DIR\n");
+    std::fprintf(stderr, "usage: make_stream_seeds LOG OUT_DIR | make_stream_seeds --to-log INPUT OUT_DIR\n");
     return 2;
   }
   const std::vector<gins::LogRecord> log = gins::fuzz::ReadLog(argv[1]);

@@ -40,8 +40,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <deque>
 #include <memory>
+#include <string>
 
 #include "core/geodesy.h"
 #include "core/io/log_reader.h"
@@ -451,6 +453,38 @@ inline void StreamDecoder::VehicleFix(double t, uint8_t sensors) {
     v.gvel.v_enu = car_.speed * Vec3(std::cos(car_.yaw), std::sin(car_.yaw), 0.0);
     Emit(v, t);
   }
+}
+
+// The record as a line of the gins log format (all digits), for reproducing an input with `gins run`.
+inline std::string ToLogLine(const LogRecord& r) {
+  char buf[320];
+  switch (r.type) {
+    case LogRecord::Type::kImu:
+      std::snprintf(buf, sizeof(buf), "IMU %.17g %.17g %.17g %.17g %.17g %.17g %.17g", r.imu.t, r.imu.gyro.x(),
+                    r.imu.gyro.y(), r.imu.gyro.z(), r.imu.acc.x(), r.imu.acc.y(), r.imu.acc.z());
+      break;
+    case LogRecord::Type::kOdom:
+      std::snprintf(buf, sizeof(buf), "ODOM %.17g %.17g %.17g", r.odom.t, r.odom.left_pulses, r.odom.right_pulses);
+      break;
+    case LogRecord::Type::kGnss: {
+      const GnssRecord& g = r.gnss;
+      int n = std::snprintf(buf, sizeof(buf), "GNSS %.17g %.17g %.17g %.17g %.17g %d", g.t, g.lat_deg, g.lon_deg,
+                            g.alt_m, g.heading_deg, g.heading_valid ? 1 : 0);
+      if (g.has_sigma) {
+        std::snprintf(buf + n, sizeof(buf) - n, " %.17g %.17g %.17g", g.sigma_enu.x(), g.sigma_enu.y(), g.sigma_enu.z());
+      }
+      break;
+    }
+    case LogRecord::Type::kGvel: {
+      const GvelRecord& v = r.gvel;
+      int n = std::snprintf(buf, sizeof(buf), "GVEL %.17g %.17g %.17g %.17g", v.t, v.v_enu.x(), v.v_enu.y(), v.v_enu.z());
+      if (v.has_sigma) {
+        std::snprintf(buf + n, sizeof(buf) - n, " %.17g %.17g %.17g", v.sigma_enu.x(), v.sigma_enu.y(), v.sigma_enu.z());
+      }
+      break;
+    }
+  }
+  return buf;
 }
 
 }  // namespace gins::fuzz

@@ -76,11 +76,18 @@ inline constexpr auto kWheelKeys = [](auto& v, WheelOptions& o) {
   v.Number("scale_sigma", o.scale_sigma, kNoUnit, Positive());
   v.Number("scale_rw_per_sqrt_s", o.scale_rw, kNoUnit, Positive());
   v.Boolean("estimate_scale", o.estimate_scale);
+  v.Vector3("lever_arm_m", o.lever_b, kLeverWhat, kLeverCheck);
+  v.Number("track_m", o.track, kNoUnit, Within(0.0, 100.0));
+};
+
+inline constexpr auto kVehicleKeys = [](auto& v, VehicleOptions& o) {
   v.Boolean("nonholonomic", o.nonholonomic);
   v.Number("nhc_sigma_m_s", o.nhc_sigma, kNoUnit, Positive());
+  v.Number("nhc_rate_hz", o.nhc_rate, kNoUnit, Within(0.01, 1000.0));
 };
 
 inline constexpr auto kGravityKeys = [](auto& v, GravityOptions& o) {
+  v.Boolean("earth_rotation", o.earth_rotation);
   v.Choice("model", o.use_normal_gravity, Choices<bool>{{"normal", true}, {"fixed", false}});
   // Earth's surface gravity spans 9.76-9.84 m/s²; anything far outside is a typo, not a place.
   v.Number("magnitude_m_s2", o.magnitude, kNoUnit, Within(9.7, 9.9));
@@ -101,6 +108,7 @@ inline constexpr auto kInitKeys = [](auto& v, InitOptions& o) {
 inline constexpr auto kEskfKeys = [](auto& v, EskfOptions& o) {
   v.Boolean("estimate_gravity", o.estimate_gravity);
   v.Number("gravity_sigma_m_s2", o.gravity_sigma, kNoUnit, Positive());
+  v.Integer("iterations", o.iterations, 1, 50);
 };
 
 inline constexpr auto kSmootherKeys = [](auto& v, SmootherOptions& o) {
@@ -182,6 +190,7 @@ inline constexpr auto kOptionsKeys = [](auto& v, Options& o) {
   v.Section("imu", o.imu, kImuKeys);
   v.Section("gnss", o.gnss, kGnssKeys);
   v.Section("wheel", o.wheel, kWheelKeys);
+  v.Section("vehicle", o.vehicle, kVehicleKeys);
   v.Section("gravity", o.gravity, kGravityKeys);
   v.Section("init", o.init, kInitKeys);
   v.Section("eskf", o.eskf, kEskfKeys);

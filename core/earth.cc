@@ -15,9 +15,22 @@ Vec3 NormalGravityWorld(const LocalEnuFrame& frame, const Vec3& p_w) {
 
 EarthModel::EarthModel(double g_norm) : g_norm_(g_norm) { g_centre_ = GravityWorld(g_norm); }
 
+EarthModel EarthModel::FromOptions(const LocalEnuFrame& frame, const GravityOptions& options) {
+  if (options.earth_rotation && options.use_normal_gravity) return Rotating(frame);
+  EarthModel e(options.use_normal_gravity ? NormalGravity(frame.origin().lat_deg, frame.origin().alt_m)
+                                          : options.magnitude);
+  if (options.earth_rotation) {
+    e.rotating_ = true;
+    const double lat = frame.origin().lat_deg * kDegToRad;
+    e.rate_w_ = kEarthRate * Vec3(0.0, std::cos(lat), std::sin(lat));
+  }
+  return e;
+}
+
 EarthModel EarthModel::Rotating(const LocalEnuFrame& frame) {
   EarthModel e;
   e.rotating_ = true;
+  e.by_position_ = true;
   e.frame_.emplace(frame);
   const double lat = frame.origin().lat_deg * kDegToRad;
   e.rate_w_ = kEarthRate * Vec3(0.0, std::cos(lat), std::sin(lat));
@@ -39,7 +52,7 @@ void EarthModel::Refresh(const Vec3& centre_w) const {
 }
 
 Vec3 EarthModel::Gravity(const Vec3& p_w) const {
-  if (!rotating_) return g_centre_;
+  if (!by_position_) return g_centre_;
   const Vec3 d = p_w - centre_w_;
   if (!(d.squaredNorm() <= kRefreshDistance * kRefreshDistance)) {
     if (!p_w.allFinite()) return g_centre_;  // a diverged state must not poison the cache

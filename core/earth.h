@@ -19,6 +19,7 @@
 
 #include "core/conventions.h"
 #include "core/geodesy.h"
+#include "core/sensors.h"
 
 namespace gins {
 
@@ -31,6 +32,10 @@ class EarthModel {
   explicit EarthModel(double g_norm = kStandardGravity);
   // The rotating model about the frame's origin, with WGS84 normal gravity.
   static EarthModel Rotating(const LocalEnuFrame& frame);
+  // What the options ask for at this origin: gravity.earth_rotation picks rotating or flat;
+  // gravity.model picks normal gravity (by position when rotating, at the origin when flat) or the fixed
+  // magnitude (constant, straight down).
+  static EarthModel FromOptions(const LocalEnuFrame& frame, const GravityOptions& options);
 
   bool rotating() const { return rotating_; }
   // ω_ie in w (rad/s); zero for the flat model.
@@ -48,6 +53,7 @@ class EarthModel {
   void Refresh(const Vec3& centre_w) const;
 
   bool rotating_ = false;
+  bool by_position_ = false;  // gravity from the frame's normal gravity at each position
   double g_norm_ = kStandardGravity;
   Vec3 rate_w_ = Vec3::Zero();
   std::optional<LocalEnuFrame> frame_;  // the rotating model's

@@ -44,6 +44,11 @@ Mat3 LocalEnuFrame::RotationFromLocalEnu(const GeodeticPoint& p) const {
   return R_w_l;
 }
 
+double LocalYawToWorld(const LocalEnuFrame& frame, const GeodeticPoint& p, double yaw_local) {
+  const Vec3 d_w = frame.RotationFromLocalEnu(p) * Vec3(std::cos(yaw_local), std::sin(yaw_local), 0.0);
+  return std::atan2(d_w.y(), d_w.x());
+}
+
 double NormalGravity(double lat_deg, double alt_m) {
   // Gravity (gravitation + centrifugal) of the WGS84 ellipsoid: northward and upward components.
   double gamma_y = 0.0, gamma_z = 0.0;

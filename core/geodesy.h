@@ -37,6 +37,10 @@ class LocalEnuFrame {
   std::unique_ptr<GeographicLib::LocalCartesian> proj_;
 };
 
+// A yaw measured in the local ENU frame at p (e.g. a heading against true north there), as a yaw in w: the
+// two differ by the meridian convergence, about Δlon·sin(lat) (0.01° at 1 km east at 30°).
+double LocalYawToWorld(const LocalEnuFrame& frame, const GeodeticPoint& p, double yaw_local);
+
 // Magnitude of WGS84 normal gravity at a latitude and height (m/s²).
 double NormalGravity(double lat_deg, double alt_m);
 

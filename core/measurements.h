@@ -67,6 +67,12 @@ struct WheelMeasurement {
   double sigma = 0.0;   // m/s
   double interval = 0.0;  // s: the speed is the mean over (t − interval, t]
   bool standstill = false;  // both wheels reported zero pulses
+  // The turn rate from the two wheels' speed difference over the track (rad/s, mean over the interval, read
+  // with the odometer scale like the speeds), when the track is known.
+  bool has_yaw_rate = false;
+  double yaw_rate = 0.0;
+  double yaw_rate_sigma = 0.0;  // rad/s
+  double distance = 0.0;        // m: speed·interval, the axle centre's travel over the interval
 };
 
 // The vehicle stands still (core/standstill_detector.h), continuously from `since` to t.

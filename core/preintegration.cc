@@ -128,13 +128,14 @@ NavState Preintegration::Predict(const NavState& state_i, const Vec3& g_w) const
   return state_j;
 }
 
-Mat15 PredictedCovariance(const NavState& x_i, const Mat15& P_i, const Preintegration& pre, double gyro_bias_rw,
-                          double acc_bias_rw) {
+void PredictedTransition(const NavState& x_i, const Preintegration& pre, double gyro_bias_rw, double acc_bias_rw,
+                         Mat15* Phi_out, Mat15* Q_out) {
   const Preintegration::Delta d = pre.Corrected(x_i.bg, x_i.ba);
   const Mat3 R_i = x_i.R_wb();
   const double T = pre.dt();
   const Mat96& J = pre.bias_jacobian();
-  Mat15 Phi = Mat15::Identity();
+  Mat15& Phi = *Phi_out;
+  Phi.setIdentity();
   Phi.block<3, 3>(nav::kP, nav::kV) = Mat3::Identity() * T;
   Phi.block<3, 3>(nav::kP, nav::kTheta) = -R_i * Hat<double>(d.dp);
   Phi.block<3, 3>(nav::kV, nav::kTheta) = -R_i * Hat<double>(d.dv);
@@ -146,12 +147,19 @@ Mat15 PredictedCovariance(const NavState& x_i, const Mat15& P_i, const Preintegr
   Mat9 Rot = Mat9::Identity();
   Rot.block<3, 3>(preint::kP, preint::kP) = R_i;
   Rot.block<3, 3>(preint::kV, preint::kV) = R_i;
-  const Mat9 Q9 = Rot * pre.cov() * Rot.transpose();
-  Mat15 P = Phi * P_i * Phi.transpose();
+  Mat15& Q = *Q_out;
+  Q.setZero();
   // Preintegration order (δp, δv, δθ) is NavState's first nine.
-  P.topLeftCorner<9, 9>() += Q9;
-  P.block<3, 3>(nav::kBg, nav::kBg).diagonal().array() += gyro_bias_rw * gyro_bias_rw * T;
-  P.block<3, 3>(nav::kBa, nav::kBa).diagonal().array() += acc_bias_rw * acc_bias_rw * T;
+  Q.topLeftCorner<9, 9>() = Rot * pre.cov() * Rot.transpose();
+  Q.block<3, 3>(nav::kBg, nav::kBg).diagonal().setConstant(gyro_bias_rw * gyro_bias_rw * T);
+  Q.block<3, 3>(nav::kBa, nav::kBa).diagonal().setConstant(acc_bias_rw * acc_bias_rw * T);
+}
+
+Mat15 PredictedCovariance(const NavState& x_i, const Mat15& P_i, const Preintegration& pre, double gyro_bias_rw,
+                          double acc_bias_rw) {
+  Mat15 Phi, Q;
+  PredictedTransition(x_i, pre, gyro_bias_rw, acc_bias_rw, &Phi, &Q);
+  const Mat15 P = Phi * P_i * Phi.transpose() + Q;
   return 0.5 * (P + P.transpose());
 }
 

@@ -160,6 +160,9 @@ class Preintegration {
 // interval), and Earth rotation changes Φ by ~ω·Δt (1e-4): both are left out.
 Mat15 PredictedCovariance(const NavState& x_i, const Mat15& P_i, const Preintegration& pre, double gyro_bias_rw,
                           double acc_bias_rw);
+// The same as a transition δx_j = Φ·δx_i + n, cov(n) = Q (for joint covariances of states i and j).
+void PredictedTransition(const NavState& x_i, const Preintegration& pre, double gyro_bias_rw, double acc_bias_rw,
+                         Mat15* Phi, Mat15* Q);
 
 // Preintegration::Predict written once for any scalar type (the factors that attach a measurement at a time
 // between keyframes differentiate it with Ceres's Jets): pose and velocity at j from state i and its biases,

@@ -56,19 +56,30 @@ struct WheelOptions {
   bool enabled = true;              // wheel.enabled
   double radius = 0.155;            // wheel.radius_m
   double pulses_per_rev = 1024.0;   // wheel.pulses_per_rev
-  double interval = 0.1;            // wheel.interval_s: pulse counting interval
+  double interval = 0.1;            // wheel.interval_s: nominal pulse counting interval (records' own
+                                    // spacing is used within ±50 % of it)
   double speed_sigma = 0.1;         // wheel.speed_sigma_m_s
   double gate_probability = 0.9999; // wheel.gate_probability
   double scale_sigma = 0.05;        // wheel.scale_sigma: prior 1-σ of the odometer scale (initial value 1)
   double scale_rw = 1e-4;           // wheel.scale_rw_per_sqrt_s: random walk of the scale
   bool estimate_scale = true;       // wheel.estimate_scale
-  bool nonholonomic = false;        // wheel.nonholonomic: zero lateral/vertical body speed
-  double nhc_sigma = 0.1;           // wheel.nhc_sigma_m_s
+  Vec3 lever_b = Vec3::Zero();      // wheel.lever_arm_m: the rear-axle centre in b (where the NHC holds)
+  double track = 0.0;               // wheel.track_m: left-right wheel distance; 0 = no yaw-rate aid
+};
+
+// vehicle.*: constraints of the vehicle itself, whatever its sensors.
+struct VehicleOptions {
+  bool nonholonomic = true;         // vehicle.nonholonomic: no sideways or vertical speed at the rear axle
+  double nhc_sigma = 0.1;           // vehicle.nhc_sigma_m_s: 1-σ of that speed
+  double nhc_rate = 10.0;           // vehicle.nhc_rate_hz: how often the ESKF applies it
 };
 
 // gravity.*
 struct GravityOptions {
-  bool use_normal_gravity = true;   // gravity.model: normal (WGS84 at the origin) | fixed
+  // gravity.earth_rotation: the Earth turns under w (Earth rate, Coriolis, normal gravity by position:
+  // core/earth.h); false = the flat, non-rotating model.
+  bool earth_rotation = true;
+  bool use_normal_gravity = true;   // gravity.model: normal (WGS84) | fixed
   double magnitude = kStandardGravity;  // gravity.magnitude_m_s2 (model fixed)
 };
 
@@ -77,6 +88,7 @@ struct SensorOptions {
   ImuOptions imu;
   GnssOptions gnss;
   WheelOptions wheel;
+  VehicleOptions vehicle;
   GravityOptions gravity;
 };
 

@@ -45,7 +45,8 @@ WindowStats ComputeStats(const std::deque<ImuSample>& w) {
 
 }  // namespace
 
-StaticInitializer::StaticInitializer(const InitializerOptions& options, double g_norm) : options_(options), g_norm_(g_norm) {}
+StaticInitializer::StaticInitializer(const InitializerOptions& options, const EarthModel& earth)
+    : options_(options), earth_(earth), g_norm_(earth.g_norm()) {}
 
 bool StaticInitializer::WindowIsStatic() const {
   if (window_.size() < 10) return false;
@@ -104,6 +105,7 @@ void StaticInitializer::StartFromStandstill() {
   r.static_start = window_.front().t;
   r.static_end = window_.back().t;
   r.g_norm = g_norm_;
+  r.earth = earth_;
   r.gyro_std = s.gyro_std;
   r.acc_std = s.acc_std;
   r.gyro_noise_density = s.gyro_std.mean() * std::sqrt(s.mean_dt);
@@ -114,6 +116,7 @@ void StaticInitializer::StartFromStandstill() {
   const Vec3 up_b = s.acc_mean.normalized();
   r.x0.ba = s.acc_mean - g_norm_ * up_b;
   kin_.q = Quat::FromTwoVectors(up_b, Vec3::UnitZ());
+  q_static_free_ = kin_.q;
   kin_.v.setZero();
   kin_.p.setZero();
   kin_time_ = window_.back().t;
@@ -192,6 +195,9 @@ void StaticInitializer::Finish(const GnssMeasurement& gnss, double yaw_offset, c
   const Quat q_yaw = QuatFromYaw(yaw_offset);
   r.x0.t = gnss.t;
   r.x0.q_wb = (q_yaw * kin_.q).normalized();
+  // At rest the gyro read its bias plus the Earth rate; with the yaw known, the Earth rate is taken out
+  // so the bias is the sensor's own.
+  r.x0.bg -= (q_yaw * q_static_free_).conjugate() * earth_.rate_w();
   r.x0.p_wb = gnss.p_w - r.x0.q_wb * options_.gnss.lever_b;
   const bool motion = source == "motion";
   if (wheel_seen_) {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/sensors.h"
+#include "core/earth.h"
 #include "core/imu_kernel.h"
 #include "core/measurements.h"
 #include "core/nav_state.h"
@@ -41,6 +42,7 @@ struct InitResult {
   NavState x0;                    // at x0.t, the GNSS epoch that completed the initialisation
   Mat15 P0 = Mat15::Identity();   // covariance in the NavState tangent (δp, δv, δθ, δbg, δba)
   double g_norm = kStandardGravity;
+  EarthModel earth;               // the Earth the estimators start in (gravity.*)
   double static_start = 0.0, static_end = 0.0;
   Vec3 gyro_std = Vec3::Zero();   // per-sample standard deviation at rest, rad/s
   Vec3 acc_std = Vec3::Zero();    // m/s²
@@ -51,7 +53,10 @@ struct InitResult {
 
 class StaticInitializer {
  public:
-  StaticInitializer(const InitializerOptions& options, double g_norm);
+  StaticInitializer(const InitializerOptions& options, const EarthModel& earth);
+  // The flat Earth with constant gravity of magnitude g_norm.
+  StaticInitializer(const InitializerOptions& options, double g_norm)
+      : StaticInitializer(options, EarthModel(g_norm)) {}
 
   void AddImu(const ImuSample& imu);
   void AddWheel(const WheelMeasurement& wheel);
@@ -68,7 +73,9 @@ class StaticInitializer {
   void Finish(const GnssMeasurement& gnss, double yaw_offset, const std::string& source);
 
   InitializerOptions options_;
+  EarthModel earth_;
   double g_norm_;
+  Quat q_static_free_ = Quat::Identity();  // attitude at the standstill in the yaw-free frame
   std::deque<ImuSample> window_;   // IMU samples of the current candidate standstill
   std::deque<WheelMeasurement> wheel_window_;
   bool wheel_seen_ = false;

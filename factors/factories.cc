@@ -9,6 +9,7 @@
 #include "factors/gnss_preint_factor.h"
 #include "factors/gvel_factor.h"
 #include "factors/odometer_factor.h"
+#include "factors/preint_attached_factor.h"
 #include "factors/wheel_yaw_factor.h"
 #include "factors/heading_factor.h"
 #include "factors/nhc_factor.h"
@@ -41,13 +42,33 @@ ceres::CostFunction* NhcFactor::Create(double sigma, const Vec3& omega_b, const 
   return new ceres::AutoDiffCostFunction<NhcFactor, 2, pose::kAmbient, 3>(new NhcFactor(sigma, omega_b, lever_b));
 }
 
+template <class Measurement>
+ceres::CostFunction* PreintAttachedFactor<Measurement>::Create(std::shared_ptr<const Preintegration> preint,
+                                                               const ImuEarthTerms& earth, Measurement measurement) {
+  // The callers floor every σ and never attach over an empty interval: data cannot reach these.
+  CHECK(preint != nullptr && preint->dt() > 0.0) << "PreintAttachedFactor over an empty preintegration";
+  return new PreintAttachedCostFunction<Measurement>(std::move(preint), earth, std::move(measurement));
+}
+
+template <class Measurement>
+ceres::CostFunction* PreintAttachedFactor<Measurement>::CreateAutoDiff(std::shared_ptr<const Preintegration> preint,
+                                                                       const ImuEarthTerms& earth,
+                                                                       Measurement measurement) {
+  CHECK(preint != nullptr && preint->dt() > 0.0) << "PreintAttachedFactor over an empty preintegration";
+  return new ceres::AutoDiffCostFunction<PreintAttachedFactor<Measurement>, Measurement::kResidualDim,
+                                         pose::kAmbient, 3, 6>(
+      new PreintAttachedFactor<Measurement>(std::move(preint), earth, std::move(measurement)));
+}
+template class PreintAttachedFactor<GnssAtTime>;
+template class PreintAttachedFactor<HeadingAtTime>;
+template class PreintAttachedFactor<GvelAtTime>;
+
 ceres::CostFunction* GnssPreintFactor::Create(std::shared_ptr<const Preintegration> preint,
                                               const ImuEarthTerms& earth, const Vec3& z_w, const Vec3& sigma_w,
                                               const Vec3& lever_b) {
   CHECK((sigma_w.array() > 0.0).all()) << "GnssPreintFactor: σ must be > 0, got " << sigma_w.transpose();
-  CHECK(preint != nullptr);
-  return new ceres::AutoDiffCostFunction<GnssPreintFactor, 3, pose::kAmbient, 3, 6>(
-      new GnssPreintFactor(std::move(preint), earth, z_w, sigma_w, lever_b));
+  return PreintAttachedFactor<GnssAtTime>::Create(std::move(preint), earth,
+                                                  GnssAtTime{z_w, sigma_w.cwiseInverse(), lever_b});
 }
 
 ceres::CostFunction* GvelFactor::Create(const Vec3& z_w, const Vec3& sigma_w, const Vec3& omega_b,

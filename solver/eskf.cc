@@ -30,13 +30,15 @@ Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state)
   gate_heading_ = Chi2Gate(options_.gnss.gate_probability, 1);
   gate_wheel_ = Chi2Gate(options_.wheel.gate_probability, 1);
   gate_nhc_ = Chi2Gate(options_.wheel.gate_probability, 2);
+  gate_wheel_yaw_ = Chi2Gate(options_.wheel.gate_probability, 1);
   gate_zupt_ = Chi2Gate(options_.wheel.gate_probability, 3);
   gate_zero_rate_ = Chi2Gate(kZeroRateGateProbability, 3);
 }
 
 void Eskf::Initialize(const InitResult& init) {
   x_ = init.x0;
-  g_w_ = GravityWorld(init.g_norm);
+  earth_ = init.earth;
+  dg_w_.setZero();
   scale_ = 1.0;
   P_.setZero();
   P_.topLeftCorner<nav::kDim, nav::kDim>() = init.P0;
@@ -50,6 +52,10 @@ void Eskf::Initialize(const InitResult& init) {
   gyro_sum_.setZero();
   gyro_count_ = 0;
   gyro_sum_start_ = x_.t;
+  wheel_gyro_sum_.setZero();
+  wheel_gyro_count_ = 0;
+  last_nhc_t_ = x_.t;
+  gnss_inflation_.Accepted();
   watchdog_.Clear();
   initialized_ = true;
   if (on_state_) on_state_(Estimate());
@@ -61,11 +67,13 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   if (held == nullptr) held = &*last_imu_;
   // Across an IMU gap, coast: no rotation, no acceleration (the held sample says nothing about the gap).
   const bool gap = t - last_imu_->t > options_.imu.max_gap;
-  const Vec3 omega = gap ? Vec3::Zero() : Vec3(held->gyro - x_.bg);
-  const Vec3 acc = gap ? Vec3(x_.q_wb.conjugate() * -g_w_) : Vec3(held->acc - x_.ba);
+  const Vec3 g_w = gravity();
+  const Vec3& rate_w = earth_.rate_w();
+  const Vec3 omega = gap ? Vec3(x_.q_wb.conjugate() * rate_w) : Vec3(held->gyro - x_.bg);
+  const Vec3 acc = gap ? Vec3(x_.q_wb.conjugate() * (2.0 * rate_w.cross(x_.v_w) - g_w)) : Vec3(held->acc - x_.ba);
   Kinematics k{x_.q_wb, x_.v_w, x_.p_wb};
   ImuStepJacobians J;
-  k = ImuStep(k, omega, acc, g_w_, dt, &J);
+  k = ImuStep(k, omega, acc, g_w, dt, &J, rate_w);
   a_w_ = (k.v - x_.v_w) / dt;
   x_.q_wb = k.q;
   x_.v_w = k.v;
@@ -131,24 +139,99 @@ void Eskf::AddImu(const ImuSample& imu) {
   last_imu_ = imu;
   gyro_sum_ += imu.gyro;
   ++gyro_count_;
+  wheel_gyro_sum_ += imu.gyro;
+  ++wheel_gyro_count_;
+  // The vehicle's own constraint, at its own rate, wheels or not.
+  if (options_.vehicle.nonholonomic && imu.t - last_nhc_t_ >= 1.0 / options_.vehicle.nhc_rate - 1e-9) {
+    last_nhc_t_ = imu.t;
+    UpdateNonHolonomic(imu.t);
+  }
   if (on_state_) on_state_(Estimate());
 }
 
 template <int M>
-bool Eskf::Update(const Eigen::Matrix<double, M, 1>& r, std::initializer_list<eskf::BlockJacobian<M>> H,
-                  const Eigen::Matrix<double, M, M>& R, double gate, MeasurementCounts* counts, double t) {
-  VecP dx;
-  if (!eskf::GatedUpdate<M, eskf::kDim>(r, eskf::EmbedJacobian<M>(H), R, gate, t, counts, &P_, &dx)) {
+bool Eskf::Update(const Model<M>& model, const Eigen::Matrix<double, M, M>& R, double gate, MeasurementCounts* counts,
+                  double t, double inflation, Eigen::Matrix<double, M, 1>* innovation_out,
+                  Eigen::Matrix<double, M, M>* S_out) {
+  using MatM = Eigen::Matrix<double, M, M>;
+  using MatPM = Eigen::Matrix<double, eskf::kDim, M>;
+  Linearized<M> lin = model();
+  if (S_out != nullptr || innovation_out != nullptr) {
+    if (S_out != nullptr) *S_out = lin.H * P_.lazyProduct(lin.H.transpose()) + R;
+    if (innovation_out != nullptr) *innovation_out = -lin.r;
+  }
+  // The prior, its covariance doubted by the inflation on the kinematic block (D·P·D keeps it positive).
+  MatP P0 = P_;
+  if (inflation > 1.0) {
+    const double f = std::sqrt(inflation);
+    P0.topRows<eskf::kKinematicDim>() *= f;
+    P0.leftCols<eskf::kKinematicDim>() *= f;
+  }
+  MatPM PHt = P0.lazyProduct(lin.H.transpose());
+  MatM S = lin.H.lazyProduct(PHt) + R;
+  Eigen::LLT<MatM> llt(S);
+  if (llt.info() != Eigen::Success || !lin.r.allFinite()) {
+    counts->Reject("numerical", t);
     return false;
   }
-  Inject(dx);
+  if (!(lin.r.dot(llt.solve(lin.r)) <= gate)) {  // a NaN χ² is rejected too
+    counts->Reject("chi2_gate", t);
+    return false;
+  }
+  // Iterated update (IKFoM): at iterate x_i = x̂ ⊞ δ the prior is N(−δ, P_i) in x_i's tangent, with P_i
+  // the prior covariance carried there (its δθ rows and columns by Jr(δθ)); the Gauss-Newton step from x_i
+  // is e = −δ − K_i·(r_i − H_i·δ). One iteration is the classic ESKF update.
+  const NavState x0 = x_;
+  const Vec3 dg0 = dg_w_;
+  const double s0 = scale_;
+  MatP Pi = P0;
+  MatPM K = llt.solve(PHt.transpose()).transpose();
+  VecP e = -K * lin.r;
+  for (int it = 1;; ++it) {
+    MoveNominal(e);
+    // Converged when the step is below 1 % of the σ of every state.
+    const bool small = (e.array().abs() <= 0.01 * Pi.diagonal().array().sqrt()).all();
+    if (it >= options_.eskf.iterations || small) break;
+    lin = model();
+    const VecP delta = NominalMinus(x0, dg0, s0);
+    const Mat3 Jr = RightJacobian(Vec3(eskf::SegmentOf<Block::kTheta>(delta)));
+    Pi = P0;
+    const Eigen::Matrix<double, 3, eskf::kDim> rows = Jr * eskf::RowsOf<Block::kTheta>(Pi);
+    eskf::RowsOf<Block::kTheta>(Pi) = rows;
+    const Eigen::Matrix<double, eskf::kDim, 3> cols = eskf::ColsOf<Block::kTheta>(Pi) * Jr.transpose();
+    eskf::ColsOf<Block::kTheta>(Pi) = cols;
+    PHt = Pi.lazyProduct(lin.H.transpose());
+    S = lin.H.lazyProduct(PHt) + R;
+    llt.compute(S);
+    if (llt.info() != Eigen::Success) break;  // keep the last good iterate
+    K = llt.solve(PHt.transpose()).transpose();
+    e = -delta - K * (lin.r - lin.H * delta);
+  }
+  // Joseph form at the last linearisation, (I−KH)P(I−KH)ᵀ + KRKᵀ, which keeps P symmetric and positive for
+  // any gain, expanded as P − K(PHᵀ)ᵀ − PHᵀKᵀ + KSKᵀ: rank-M products instead of three N×N ones.
+  const MatPM KS = K.lazyProduct(S);
+  const MatP KHP = K.lazyProduct(PHt.transpose());
+  P_ = Pi + KS.lazyProduct(K.transpose()) - KHP - KHP.transpose();
+  ResetCovariance(e);
+  ++counts->used;
   return true;
 }
 
-void Eskf::Inject(const VecP& dx) {
+void Eskf::MoveNominal(const VecP& dx) {
   x_ = x_.Boxplus(dx.head<nav::kDim>());
-  g_w_ += eskf::SegmentOf<Block::kG>(dx);
+  dg_w_ += eskf::SegmentOf<Block::kG>(dx);
   scale_ += dx[eskf::kS];
+}
+
+Eskf::VecP Eskf::NominalMinus(const NavState& x, const Vec3& dg, double s) const {
+  VecP d = VecP::Zero();
+  d.head<nav::kDim>() = x_.Boxminus(x);
+  eskf::SegmentOf<Block::kG>(d) = dg_w_ - dg;
+  d[eskf::kS] = scale_ - s;
+  return d;
+}
+
+void Eskf::ResetCovariance(const VecP& dx) {
   // Reset: the error is now zero about the corrected rotation; project the covariance accordingly
   // (right perturbation: ∂δθ⁺/∂δθ = I − ½[δθ]×).
   // Jr is the identity but for its δθ block, so only the δθ rows and columns of P change.
@@ -160,148 +243,13 @@ void Eskf::Inject(const VecP& dx) {
   P_ = 0.5 * (P_ + P_.transpose()).eval();
 }
 
-void Eskf::AddGnss(const GnssMeasurement& m) {
-  if (!initialized_ || m.t < x_.t) return;
-  Propagate(m.t);
-  if (options_.watchdog.enabled) {
-    const double max_sigma = options_.watchdog.max_position_sigma;
-    const bool finite = x_.AllFinite() && P_.allFinite() && g_w_.allFinite() && std::isfinite(scale_);
-    if (!finite || BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
-      ResetFromGnss(m, finite ? "covariance" : "non_finite");
-      prev_fix_ = m;
-      return;
-    }
-  }
-  bool accepted = false;
-  {
-    Eigen::Matrix<double, 3, 1> r;
-    Eigen::Matrix<double, 3, 6> H6;  // (δp, δθ)
-    const NavState& x = x_;
-    Linearize<3, 6>(
-        [&](const auto& d) {
-          using T = typename std::decay_t<decltype(d)>::Scalar;
-          const Eigen::Matrix<T, 3, 1> p = x.p_wb.cast<T>() + d.template head<3>();
-          const Eigen::Quaternion<T> q = x.q_wb.cast<T>() * ExpQuat<T>(d.template tail<3>());
-          return GnssPositionModel::Residual<T>(p, q, options_.gnss.lever_b, m.p_w);
-        },
-        &r, &H6);
-    const Mat3 R = m.sigma_w.cwiseAbs2().asDiagonal();
-    accepted = Update<3>(r, {{Block::kP, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}}, R, gate_gnss_,
-                         &gnss_counts_, m.t);
-  }
-  const bool reset = WatchGnss(m, accepted);
-  prev_fix_ = m;
-  if (reset) return;
-  if (m.heading_valid && options_.gnss.use_heading) {
-    Eigen::Matrix<double, 1, 1> r;
-    Eigen::Matrix<double, 1, 3> H3;
-    const NavState& x = x_;
-    Linearize<1, 3>(
-        [&](const auto& d) {
-          using T = typename std::decay_t<decltype(d)>::Scalar;
-          const Eigen::Quaternion<T> q = x.q_wb.cast<T>() * ExpQuat<T>(d);
-          return Eigen::Matrix<T, 1, 1>(HeadingModel::Residual<T>(q, options_.gnss.mount_yaw, m.yaw_G));
-        },
-        &r, &H3);
-    Eigen::Matrix<double, 1, 1> R;
-    R(0, 0) = m.sigma_yaw * m.sigma_yaw;
-    Update<1>(r, {{Block::kTheta, H3}}, R, gate_heading_, &heading_counts_, m.t);
-  }
-}
-
-void Eskf::AddGvel(const GvelMeasurement& m) {
-  if (!initialized_ || m.t < x_.t) return;
-  Propagate(m.t);
-  // The antenna's velocity includes the lever arm's turn: the body rate from the last IMU sample.
-  const Vec3 omega_b = last_imu_ ? Vec3(last_imu_->gyro - x_.bg) : Vec3::Zero();
-  Eigen::Matrix<double, 3, 1> r;
-  Eigen::Matrix<double, 3, 6> H6;  // (δv, δθ)
-  const NavState& x = x_;
-  Linearize<3, 6>(
-      [&](const auto& d) {
-        using T = typename std::decay_t<decltype(d)>::Scalar;
-        const Eigen::Matrix<T, 3, 1> v = x.v_w.cast<T>() + d.template head<3>();
-        const Eigen::Quaternion<T> q = x.q_wb.cast<T>() * ExpQuat<T>(d.template tail<3>());
-        return GnssVelocityModel::Residual<T>(q, v, omega_b, options_.gnss.lever_b, m.v_w);
-      },
-      &r, &H6);
-  const Mat3 R = m.sigma_w.cwiseAbs2().asDiagonal();
-  Update<3>(r, {{Block::kV, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}}, R, gate_gnss_, &gvel_counts_,
-            m.t);
-}
-
-void Eskf::AddWheel(const WheelMeasurement& m) {
-  if (!initialized_ || m.t < x_.t || !options_.wheel.enabled) return;
-  Propagate(m.t);
-  // At zero pulses this is a zero-speed measurement; the standstill updates (AddStandstill) come from the
-  // session's detector, which also wants the IMU quiet.
-  {
-    Eigen::Matrix<double, 1, 1> r;
-    Eigen::Matrix<double, 1, 7> H7;  // (δv, δθ, δs)
-    const NavState& x = x_;
-    const double s0 = scale_;
-    // The encoders report the mean speed over the counting interval: compare with the velocity at its
-    // middle (at 1 m/s² and 0.1 s this is a 5 cm/s difference).
-    const Vec3 v_mid = x.v_w - a_w_ * (0.5 * m.interval);
-    Linearize<1, 7>(
-        [&](const auto& d) {
-          using T = typename std::decay_t<decltype(d)>::Scalar;
-          const Eigen::Matrix<T, 3, 1> v = v_mid.cast<T>() + d.template head<3>();
-          const Eigen::Quaternion<T> q = x.q_wb.cast<T>() * ExpQuat<T>(Eigen::Matrix<T, 3, 1>(d.template segment<3>(3)));
-          const T s = T(s0) + d[6];
-          return Eigen::Matrix<T, 1, 1>(WheelSpeedModel::Residual<T>(q, v, s, m.speed));
-        },
-        &r, &H7);
-    if (!options_.wheel.estimate_scale) H7(0, 6) = 0.0;  // a scale held fixed takes no correction
-    Eigen::Matrix<double, 1, 1> R;
-    R(0, 0) = m.sigma * m.sigma;
-    Update<1>(r,
-              {{Block::kV, H7.leftCols<3>()}, {Block::kTheta, H7.middleCols<3>(3)},
-               {Block::kS, H7.rightCols<1>()}},
-              R, gate_wheel_, &wheel_counts_, m.t);
-    if (options_.wheel.nonholonomic) {
-      Eigen::Matrix<double, 2, 1> rn;
-      Eigen::Matrix<double, 2, 6> H6;
-      Linearize<2, 6>(
-          [&](const auto& d) {
-            using T = typename std::decay_t<decltype(d)>::Scalar;
-            const Eigen::Matrix<T, 3, 1> v = x.v_w.cast<T>() + d.template head<3>();
-            const Eigen::Quaternion<T> q = x.q_wb.cast<T>() * ExpQuat<T>(Eigen::Matrix<T, 3, 1>(d.template tail<3>()));
-            return NonHolonomicModel::Residual<T>(q, v);
-          },
-          &rn, &H6);
-      const double s2 = options_.wheel.nhc_sigma * options_.wheel.nhc_sigma;
-      Update<2>(rn, {{Block::kV, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}},
-                Eigen::Matrix2d::Identity() * s2, gate_nhc_, &wheel_counts_, m.t);
-    }
-  }
-}
-
-void Eskf::AddStandstill(const StandstillMeasurement& m) {
-  if (!initialized_ || m.t < x_.t) return;
-  Propagate(m.t);
-  // The gyro mean since the last update observes the bias only if the whole interval was standing.
-  const bool rate_usable = gyro_count_ > 0 && gyro_sum_start_ >= m.since && m.t > gyro_sum_start_;
-  const Vec3 mean_gyro = gyro_count_ > 0 ? Vec3(gyro_sum_ / gyro_count_) : Vec3::Zero();
-  const double T = m.t - gyro_sum_start_;
-  gyro_sum_.setZero();
-  gyro_count_ = 0;
-  gyro_sum_start_ = m.t;
-  if (!StandstillPlausible(x_.v_w, options_.standstill)) {
-    zupt_counts_.Reject("moving", m.t);  // a quiet IMU at speed: not a stop
-    return;
-  }
-  // Standing: zero velocity, and the gyro reads its bias (zero-rate update), so nothing wanders.
-  const Eigen::Matrix<double, 3, 1> r = x_.v_w;
-  const double sv = options_.standstill.velocity_sigma;
-  Update<3>(r, {{Block::kV, Mat3::Identity()}}, Mat3::Identity() * sv * sv, gate_zupt_, &zupt_counts_, m.t);
-  if (rate_usable) {
-    const Eigen::Matrix<double, 3, 1> rg = x_.bg - mean_gyro;
-    const double sigma = 2.0 * options_.imu.gyro_noise_density / std::sqrt(T);
-    Update<3>(rg, {{Block::kBg, Mat3::Identity()}}, Mat3::Identity() * sigma * sigma, gate_zero_rate_,
-              &zupt_counts_, m.t);
-  }
-}
+// The measurement updates' instantiations (solver/eskf_measurements.cc calls them).
+template bool Eskf::Update<1>(const Model<1>&, const Eigen::Matrix<double, 1, 1>&, double, MeasurementCounts*, double,
+                              double, Eigen::Matrix<double, 1, 1>*, Eigen::Matrix<double, 1, 1>*);
+template bool Eskf::Update<2>(const Model<2>&, const Eigen::Matrix<double, 2, 2>&, double, MeasurementCounts*, double,
+                              double, Eigen::Matrix<double, 2, 1>*, Eigen::Matrix<double, 2, 2>*);
+template bool Eskf::Update<3>(const Model<3>&, const Eigen::Matrix<double, 3, 3>&, double, MeasurementCounts*, double,
+                              double, Eigen::Matrix<double, 3, 1>*, Eigen::Matrix<double, 3, 3>*);
 
 bool Eskf::WatchGnss(const GnssMeasurement& m, bool accepted) {
   if (!watchdog_.Watch(m.t, accepted)) return false;
@@ -316,7 +264,7 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
     x_.bg.setZero();
     x_.ba.setZero();
     x_.v_w.setZero();
-    g_w_ = GravityWorld(g_w_.allFinite() ? g_w_.norm() : kStandardGravity);
+    if (!dg_w_.allFinite()) dg_w_.setZero();
     if (!std::isfinite(scale_)) scale_ = 1.0;
     P_.setZero();
     P_.topLeftCorner<nav::kDim, nav::kDim>() = FallbackCovariance(options_);
@@ -356,9 +304,13 @@ nlohmann::json Eskf::Stats() const {
   j["gnss_heading"] = heading_counts_.ToJson();
   j["gnss_velocity"] = gvel_counts_.ToJson();
   j["wheel"] = wheel_counts_.ToJson();
+  j["wheel_yaw_rate"] = wheel_yaw_counts_.ToJson();
+  j["nonholonomic"] = nhc_counts_.ToJson();
+  j["gnss_reacquired"] = gnss_inflation_.reacquired();
   j["zero_velocity"] = zupt_counts_.ToJson();
   j["final_odom_scale"] = scale_;
-  j["final_gravity"] = {g_w_.x(), g_w_.y(), g_w_.z()};
+  const Vec3 g_w = gravity();
+  j["final_gravity"] = {g_w.x(), g_w.y(), g_w.z()};
   j["final_gyro_bias_deg_h"] = {x_.bg.x() * kRadToDeg * 3600, x_.bg.y() * kRadToDeg * 3600, x_.bg.z() * kRadToDeg * 3600};
   j["final_acc_bias_m_s2"] = {x_.ba.x(), x_.ba.y(), x_.ba.z()};
   return j;

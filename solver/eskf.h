@@ -2,8 +2,17 @@
 // Error state (19): δp, δv, δθ, δbg, δba, δg, δs — right perturbation (DESIGN §2), so the first 15 are
 // the NavState tangent; the layout is declared once in solver/eskf_state.h. Prediction at IMU rate through
 // the shared kernel (core/imu_kernel.h); updates linearise the shared measurement models (core/*_model.h)
-// with core/linearize.h and all go through one helper (solver/eskf_update.h): Jacobians per block,
-// Joseph-form covariance update, χ² innovation gates; then reset with covariance projection.
+// with core/linearize.h and all go through one update (Eskf::Update, solver/eskf_update.h): Jacobians per
+// block, a χ² innovation gate, an iterated update on the manifold (eskf.iterations, the IKFoM form: the
+// model is re-linearised at each iterate, the prior carried into its tangent), Joseph-form covariance, then
+// the reset with covariance projection.
+//
+// Measurements (solver/eskf_measurements.cc): GNSS position (lever arm) and dual-antenna heading, GNSS
+// velocity, wheel speed of the rear-axle centre at the middle of each record's interval (lever arm, every
+// record) and the left/right difference as a yaw-rate aid (wheel.track_m), the non-holonomic constraint at
+// vehicle.nhc_rate_hz whether or not the log has wheels, standstill updates. A run of rejected GNSS fixes
+// that agree with one another inflates the gate and, when a fix is accepted under it, the covariance it
+// updates (GateInflation, solver/estimator.h): re-acquisition after an outage by design.
 //
 // Robustness (config standstill.*, watchdog.*, imu.max_gap_s):
 // - Standstill (AddStandstill, from the session's detector): zero-velocity update (σ standstill.velocity_
@@ -20,6 +29,7 @@
 //   (watchdog.resets: time, reason) say so.
 #pragma once
 
+#include <functional>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -53,7 +63,12 @@ class Eskf : public Estimator {
 
   const NavState& state() const { return x_; }
   const MatP& covariance() const { return P_; }
-  const Vec3& gravity() const { return g_w_; }
+  // Gravity in w at the current position: the Earth model's, plus the estimated correction (δg).
+  Vec3 gravity() const { return earth_.Gravity(x_.p_wb) + dg_w_; }
+  // The body's rate against w (rad/s) from the last IMU sample: gyro less bias less the Earth rate.
+  Vec3 BodyRate() const {
+    return last_imu_ ? Vec3(last_imu_->gyro - x_.bg - x_.q_wb.conjugate() * earth_.rate_w()) : Vec3::Zero();
+  }
   double odom_scale() const { return scale_; }
   StateEstimate Estimate() const;
 
@@ -65,12 +80,34 @@ class Eskf : public Estimator {
   void PropagateCovariance(const ImuStepJacobians& J, double dt, bool gap);
   // The random walks of the driving and passive blocks over dt.
   void AddRandomWalks(double dt);
-  // Gated Kalman update with residual r = h(x) − z and its Jacobian per block it touches (eskf_update.h),
-  // injected when accepted; returns false if rejected (counted in counts).
+  // A measurement model linearised at the filter's current nominal state: its residual r = h(x) − z and
+  // full-width Jacobian (from the blocks it touches, eskf::EmbedJacobian).
   template <int M>
-  bool Update(const Eigen::Matrix<double, M, 1>& r, std::initializer_list<eskf::BlockJacobian<M>> H,
-              const Eigen::Matrix<double, M, M>& R, double gate, MeasurementCounts* counts, double t);
-  void Inject(const VecP& dx);
+  struct Linearized {
+    Eigen::Matrix<double, M, 1> r;
+    Eigen::Matrix<double, M, eskf::kDim> H;
+  };
+  template <int M>
+  using Model = std::function<Linearized<M>()>;
+  // Gated, iterated update with noise R; inflation (≥ 1) multiplies the kinematic block of the prior
+  // covariance (GateInflation). Injects and returns true when accepted; false when rejected (counted).
+  // innovation_out/S_out, if given, receive the prior innovation −r and HPHᵀ + R (uninflated: for
+  // GateInflation when the fix was rejected).
+  template <int M>
+  bool Update(const Model<M>& model, const Eigen::Matrix<double, M, M>& R, double gate, MeasurementCounts* counts,
+              double t, double inflation = 1.0, Eigen::Matrix<double, M, 1>* innovation_out = nullptr,
+              Eigen::Matrix<double, M, M>* S_out = nullptr);
+  // The nominal state moved by δx (no covariance change), and the covariance's reset for a step δx.
+  void MoveNominal(const VecP& dx);
+  void ResetCovariance(const VecP& dx);
+  // The nominal state minus (x, dg, s): the error-state vector between them.
+  VecP NominalMinus(const NavState& x, const Vec3& dg, double s) const;
+  // The measurement updates (eskf_measurements.cc).
+  bool UpdateGnssPosition(const GnssMeasurement& m);
+  void UpdateHeading(const GnssMeasurement& m);
+  void UpdateWheelSpeed(const WheelMeasurement& m);
+  void UpdateWheelYawRate(const WheelMeasurement& m);
+  void UpdateNonHolonomic(double t);
   // Watchdog: after a GNSS position update (accepted or not); returns true if it re-initialised.
   bool WatchGnss(const GnssMeasurement& m, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
@@ -79,22 +116,29 @@ class Eskf : public Estimator {
   StateCallback on_state_;
   bool initialized_ = false;
   NavState x_;
-  Vec3 g_w_ = Vec3::Zero();
+  EarthModel earth_;
+  Vec3 dg_w_ = Vec3::Zero();  // the estimated correction of the model's gravity
   double scale_ = 1.0;
   MatP P_ = MatP::Identity();
   std::optional<ImuSample> last_imu_;
   Vec3 a_w_ = Vec3::Zero();  // acceleration in w over the last IMU step
-  // Gyro readings since the last wheel epoch, for the zero-rate update at standstill.
+  // Gyro readings since the last standstill update, for the zero-rate update.
   Vec3 gyro_sum_ = Vec3::Zero();
   int gyro_count_ = 0;
   double gyro_sum_start_ = 0.0;
+  // Gyro readings since the last wheel record, for the wheels' yaw-rate aid over the same interval.
+  Vec3 wheel_gyro_sum_ = Vec3::Zero();
+  int wheel_gyro_count_ = 0;
+  double last_nhc_t_ = -1e300;
+  GateInflation gnss_inflation_;
 
   // χ² gates, computed once (the quantile is an iterative inversion).
-  double gate_gnss_ = 0.0, gate_heading_ = 0.0, gate_wheel_ = 0.0, gate_nhc_ = 0.0, gate_zupt_ = 0.0,
-         gate_zero_rate_ = 0.0;
+  double gate_gnss_ = 0.0, gate_heading_ = 0.0, gate_wheel_ = 0.0, gate_nhc_ = 0.0, gate_wheel_yaw_ = 0.0,
+         gate_zupt_ = 0.0, gate_zero_rate_ = 0.0;
   uint64_t imu_steps_ = 0;
   ImuGapLog imu_gaps_;
-  MeasurementCounts gnss_counts_, heading_counts_, gvel_counts_, wheel_counts_, zupt_counts_;
+  MeasurementCounts gnss_counts_, heading_counts_, gvel_counts_, wheel_counts_, wheel_yaw_counts_, nhc_counts_,
+      zupt_counts_;
 
   GnssWatchdog watchdog_;
   std::optional<GnssMeasurement> prev_fix_;  // the fix before the current one, accepted or not

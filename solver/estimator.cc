@@ -54,6 +54,24 @@ Mat15 FallbackCovariance(const EstimatorOptions& options) {
   return P;
 }
 
+void GateInflation::Rejected(double t, const Vec3& innovation, const Mat3& S, double gate) {
+  bool agrees = false;
+  if (run_) {
+    const Vec3 d = innovation - last_innovation_;
+    const Mat3 C = S + last_S_;
+    const Eigen::LLT<Mat3> llt(C);
+    agrees = llt.info() == Eigen::Success && d.dot(llt.solve(d)) <= gate;
+  }
+  if (!agrees) {
+    run_ = true;
+    start_ = t;
+  }
+  // Capped far beyond any useful doubt (2^60), so the factor stays finite on any log.
+  factor_ = std::exp2(std::min(t - start_, 60.0));
+  last_innovation_ = innovation;
+  last_S_ = S;
+}
+
 void ImuGapLog::Add(double last_sample, double next_sample) {
   ++count_;
   if (times_.size() < kMaxListedTimes) times_.emplace_back(last_sample, next_sample);

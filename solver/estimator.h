@@ -62,6 +62,35 @@ class GnssWatchdog {
   uint64_t count_ = 0;
 };
 
+// Re-acquiring GNSS after an outage by design. A run of rejected fixes that agree with one another says the
+// estimate, not the fixes, is off: an overconfident covariance (an IMU noisier than its configuration,
+// vibration) would otherwise reject every returning fix until the watchdog. While such a run lasts, the gate
+// doubts the predicted covariance more and more: by a factor 2^(seconds since the run began), whatever the
+// fix rate. A drifted estimate then re-acquires within a few fixes; an outlier burst metres away from an
+// estimate that knows its place to centimetres would need a factor of 1e5-1e6, more seconds than the
+// watchdog's max_reject_s, and stays out. Rejected fixes that disagree with one another (scattered
+// outliers) restart the run. Both estimators use it for GNSS positions.
+class GateInflation {
+ public:
+  // The factor the next gate multiplies the predicted covariance by (1 outside a run).
+  double factor() const { return factor_; }
+  // A fix at t was rejected: its innovation ν (measured − predicted) and the innovation covariance S the
+  // gate used without inflation; gate: the χ² bound for two such innovations to agree.
+  void Rejected(double t, const Vec3& innovation, const Mat3& S, double gate);
+  void Accepted() { run_ = false, factor_ = 1.0; }
+  // How many fixes were accepted under a factor > 1 (re-acquisitions), for the summary.
+  uint64_t reacquired() const { return reacquired_; }
+  void CountReacquired() { ++reacquired_; }
+
+ private:
+  bool run_ = false;
+  double start_ = 0.0;
+  Vec3 last_innovation_ = Vec3::Zero();
+  Mat3 last_S_ = Mat3::Identity();
+  double factor_ = 1.0;
+  uint64_t reacquired_ = 0;
+};
+
 // IMU gaps longer than imu.max_gap_s, counted and the first few listed (summary: imu_gaps, imu_gap_times).
 class ImuGapLog {
  public:

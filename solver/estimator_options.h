@@ -13,6 +13,7 @@ namespace gins {
 struct EskfOptions {
   bool estimate_gravity = true;     // eskf.estimate_gravity: δg in the error state
   double gravity_sigma = 0.01;      // eskf.gravity_sigma_m_s2 initial 1-σ per axis
+  int iterations = 3;               // eskf.iterations: at most this many linearisations per update
 };
 
 // smoother.*

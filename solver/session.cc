@@ -1,5 +1,7 @@
 #include "solver/session.h"
 
+#include <cmath>
+
 #include "core/wheel_model.h"
 
 namespace gins {
@@ -10,7 +12,6 @@ constexpr size_t kMaxPending = 100000;
 
 Session::Session(const EstimatorOptions& options) : options_(options) {
   if (options_.gnss.origin) frame_.emplace(*options_.gnss.origin);
-  if (!options_.gravity.use_normal_gravity) g_norm_ = options_.gravity.magnitude;
 }
 
 void Session::AddEstimator(std::unique_ptr<Estimator> estimator) { estimators_.push_back({std::move(estimator), {}}); }
@@ -31,8 +32,9 @@ void Session::Touch(double t) {
 
 void Session::EnsureInitializer() {
   if (init_ || !frame_) return;
-  if (g_norm_ == 0.0) g_norm_ = NormalGravity(frame_->origin().lat_deg, frame_->origin().alt_m);
-  init_ = std::make_unique<StaticInitializer>(options_, g_norm_);
+  earth_ = EarthModel::FromOptions(*frame_, options_.gravity);
+  g_norm_ = earth_.g_norm();
+  init_ = std::make_unique<StaticInitializer>(options_, earth_);
   standstill_ = std::make_unique<StandstillDetector>(options_.standstill, g_norm_, options_.wheel.interval);
   // Replay what arrived before the world frame existed, in time order.
   size_t i = 0, j = 0;
@@ -91,14 +93,7 @@ void Session::AddOdom(const OdomRecord& o) {
     ++odom_ignored_;
     return;
   }
-  const WheelOptions& wo = options_.wheel;
-  WheelMeasurement w;
-  w.t = o.t;
-  w.speed = 0.5 * (WheelSpeedFromPulses(o.left_pulses, wo.radius, wo.pulses_per_rev, wo.interval) +
-                   WheelSpeedFromPulses(o.right_pulses, wo.radius, wo.pulses_per_rev, wo.interval));
-  w.sigma = wo.speed_sigma;
-  w.interval = wo.interval;
-  w.standstill = o.left_pulses == 0.0 && o.right_pulses == 0.0;
+  const WheelMeasurement w = WheelFromOdom(o);
   EnsureInitializer();
   if (standstill_) standstill_->AddWheel(w);
   if (!init_) {
@@ -114,6 +109,40 @@ void Session::AddOdom(const OdomRecord& o) {
   }
 }
 
+WheelMeasurement Session::WheelFromOdom(const OdomRecord& o) {
+  const WheelOptions& wo = options_.wheel;
+  // The pulses were counted since the previous record: its spacing is the interval, within half the
+  // nominal one either way (clock jitter, counted); a longer spacing means records were lost, and the
+  // record's own count then covers the nominal interval only (a gap, counted).
+  double interval = wo.interval;
+  if (last_odom_t_) {
+    const double spacing = o.t - *last_odom_t_;
+    if (spacing > 0.5 * wo.interval && spacing < 1.5 * wo.interval) {
+      interval = spacing;
+      if (std::abs(spacing - wo.interval) > 0.1 * wo.interval) ++wheel_jitter_;
+    } else if (spacing >= 1.5 * wo.interval) {
+      ++wheel_gaps_;
+    }
+  }
+  last_odom_t_ = o.t;
+  WheelMeasurement w;
+  w.t = o.t;
+  const double left = WheelSpeedFromPulses(o.left_pulses, wo.radius, wo.pulses_per_rev, interval);
+  const double right = WheelSpeedFromPulses(o.right_pulses, wo.radius, wo.pulses_per_rev, interval);
+  w.speed = 0.5 * (left + right);
+  w.sigma = wo.speed_sigma;
+  w.interval = interval;
+  w.distance = w.speed * interval;
+  w.standstill = o.left_pulses == 0.0 && o.right_pulses == 0.0;
+  if (wo.track > 0.0) {
+    // wheel.speed_sigma_m_s is the mean's σ: each wheel's is √2 larger, their difference's 2×.
+    w.has_yaw_rate = true;
+    w.yaw_rate = (right - left) / wo.track;
+    w.yaw_rate_sigma = 2.0 * wo.speed_sigma / wo.track;
+  }
+  return w;
+}
+
 void Session::AddGnss(const GnssRecord& g) {
   Touch(g.t);
   if (DropForSimulatedOutage(g.t)) return;
@@ -126,7 +155,9 @@ void Session::AddGnss(const GnssRecord& g) {
   // A logged σ is trusted down to a floor: a zero σ would make the fix infinitely certain.
   m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options_.gnss.min_sigma) : options_.gnss.sigma_enu;
   m.heading_valid = g.heading_valid;
-  m.yaw_G = CompassDegToEnuYaw(g.heading_deg);
+  // The receiver's heading is against true north at the antenna; w's north is the origin's.
+  m.yaw_G = g.heading_valid ? LocalYawToWorld(*frame_, *last_fix_geo_, CompassDegToEnuYaw(g.heading_deg))
+                            : CompassDegToEnuYaw(g.heading_deg);
   m.sigma_yaw = options_.gnss.heading_sigma;
   if (!initialized_) {
     init_->AddGnss(m);
@@ -180,6 +211,8 @@ nlohmann::json Session::Stats() const {
   nlohmann::json j;
   j["odom_ignored_wheel_disabled"] = odom_ignored_;
   j["gvel_unused"] = gvel_unused_;
+  j["wheel_interval_jitter"] = wheel_jitter_;
+  j["wheel_gaps"] = wheel_gaps_;
   j["dropped_before_first_fix"] = pending_dropped_;
   j["standstill_updates"] = standstill_sent_;
   // Simulated outages as absolute [begin, end) windows, and the log's own GNSS gaps.

@@ -64,6 +64,7 @@ class Session {
   EstimatorOptions options_;
   std::optional<LocalEnuFrame> frame_;
   double g_norm_ = 0.0;
+  EarthModel earth_;  // once the world frame exists
   std::unique_ptr<StaticInitializer> init_;
   bool initialized_ = false;
   struct Timed {
@@ -79,6 +80,10 @@ class Session {
   // Earth radius); those before the first fix or during initialisation, or disabled, are counted.
   std::optional<GeodeticPoint> last_fix_geo_;
   uint64_t gvel_unused_ = 0;
+  // Wheel records: the previous one's time (its spacing is the counting interval), jitter and gaps.
+  WheelMeasurement WheelFromOdom(const OdomRecord& o);
+  std::optional<double> last_odom_t_;
+  uint64_t wheel_jitter_ = 0, wheel_gaps_ = 0;
   double first_t_ = -1.0, last_t_ = 0.0;
 
   // Standstill detection (core/standstill_detector.h), fed from the initialiser's start; after

@@ -10,7 +10,9 @@
 #include "core/so3.h"
 #include "factors/imu_factor.h"
 #include "solver/marginalizer.h"
+#include "solver/smoother_gate.h"
 #include "solver/smoother_output.h"
+#include "solver/vehicle_attacher.h"
 
 namespace gins {
 namespace {
@@ -26,15 +28,20 @@ Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, Stat
       on_final_(std::move(on_final)),
       on_online_(std::move(on_online)),
       window_(options),
-      context_{window_, g_w_, last_imu_},
+      context_{window_,
+               options_,
+               earth_,
+               last_imu_,
+               [this](double t) { return PredictAt(t); },
+               [this](double t) { return AnchorAt(t); },
+               [this]() -> const MatX* { return newest_two_cov_.size() > 0 ? &newest_two_cov_ : nullptr; }},
       watchdog_(options.watchdog) {
-  // Attacher order is the order of the checks after a solve. A wrong zero velocity (a constant acceleration
-  // looks as quiet as a stop) goes first: with it in, the fix that contradicts it would be the one to fail.
-  attachers_.push_back(std::make_unique<WheelAttacher>(options_));
+  attachers_.push_back(std::make_unique<VehicleAttacher>(options_));
   attachers_.push_back(std::make_unique<StandstillAttacher>(options_));
   attachers_.push_back(std::make_unique<GvelAttacher>(options_));
-  attachers_.push_back(
-      std::make_unique<GnssAttacher>(options_, [this](double t, bool accepted) { WatchGnss(t, accepted); }));
+  attachers_.push_back(std::make_unique<GnssAttacher>(
+      options_, [this](double t, bool accepted) { WatchGnss(t, accepted); },
+      [this](double factor) { RelievePrior(factor); }));
 }
 
 Smoother::~Smoother() = default;
@@ -49,12 +56,29 @@ void Smoother::Initialize(const InitResult& init) {
   po.enable_fast_removal = true;
   problem_ = std::make_unique<ceres::Problem>(po);
   window_.Reset(problem_.get());
-  g_w_ = GravityWorld(init.g_norm);
+  earth_ = init.earth;
+  g_w_ = earth_.Gravity(init.x0.p_wb);
 
   std::unique_ptr<Keyframe> first = window_.Make(init.x0.t, init.x0);
   first->block(BlockType::kScale)[0] = initial_scale_;
   // The initial covariance as a prior on the first keyframe.
-  window_.AddPrior(window_.Push(std::move(first)), init.P0);
+  Keyframe& kf0 = window_.Push(std::move(first));
+  prior_id_ = window_.AddPrior(kf0, init.P0);
+  // Until the first solve, what the window knows of its keyframe is that prior.
+  newest_cov_id_ = kf0.id;
+  newest_two_cov_.resize(0, 0);
+  {
+    const std::vector<BlockType> types = window_.EstimatedTypes();
+    const std::vector<int> nav = NavIndexOfTangent(types);
+    newest_cov_ = MatX::Zero(nav.size(), nav.size());
+    for (size_t r = 0; r < nav.size(); ++r) {
+      for (size_t c = 0; c < nav.size(); ++c) {
+        if (nav[r] >= 0 && nav[c] >= 0) newest_cov_(r, c) = init.P0(nav[r], nav[c]);
+      }
+      if (nav[r] < 0) newest_cov_(r, r) = options_.wheel.scale_sigma * options_.wheel.scale_sigma;
+    }
+  }
+  solve_pending_ = false;
 
   preint_ = std::make_shared<Preintegration>(init.x0.bg, init.x0.ba, options_.imu.gyro_noise_density,
                                              options_.imu.acc_noise_density);
@@ -77,8 +101,8 @@ void Smoother::IntegrateTo(double t, const ImuSample* held) {
       // Across an IMU gap: no rotation and no acceleration, from the current estimate, with the
       // uncertainty of an unknown rate and acceleration held over the gap.
       coast.t = held->t;
-      coast.gyro = pred_.bg;
-      coast.acc = pred_.q_wb.conjugate() * -g_w_ + pred_.ba;
+      coast.gyro = pred_.bg + pred_.q_wb.conjugate() * earth_.rate_w();
+      coast.acc = pred_.q_wb.conjugate() * (2.0 * earth_.rate_w().cross(pred_.v_w) - g_w_) + pred_.ba;
       held = &coast;
       preint_->IntegrateGuess(coast.gyro, coast.acc, dt, kImuGapRateSigma, kImuGapAccSigma);
     } else {
@@ -86,10 +110,11 @@ void Smoother::IntegrateTo(double t, const ImuSample* held) {
     }
     interval_samples_.push_back({*held, dt});
     Kinematics k{pred_.q_wb, pred_.v_w, pred_.p_wb};
-    k = ImuStep(k, held->gyro - pred_.bg, held->acc - pred_.ba, g_w_, dt);
+    k = ImuStep(k, held->gyro - pred_.bg, held->acc - pred_.ba, g_w_, dt, nullptr, earth_.rate_w());
     pred_.q_wb = k.q;
     pred_.v_w = k.v;
     pred_.p_wb = k.p;
+    g_w_ = earth_.Gravity(pred_.p_wb);
   }
   pred_.t = t;
   t_now_ = t;
@@ -97,6 +122,8 @@ void Smoother::IntegrateTo(double t, const ImuSample* held) {
 
 void Smoother::AddImu(const ImuSample& imu) {
   if (!initialized_ || imu.t < t_now_) return;
+  // The measurements of the last epoch are all in: solve before the IMU moves on from it.
+  SolveIfPending();
   if (last_imu_ && imu.t - last_imu_->t > options_.imu.max_gap) {
     imu_gaps_.Add(last_imu_->t, imu.t);
   }
@@ -110,12 +137,88 @@ void Smoother::AddImu(const ImuSample& imu) {
   // keyframe itself, instead of a second solve at the same time.
   if (t_now_ - window_.back().t >= 1.1 * options_.smoother.max_keyframe_interval) {
     CreateKeyframe(t_now_);
-    SolveAndSlide();
+    solve_pending_ = true;
   }
 }
 
+void Smoother::SolveIfPending() {
+  if (solve_pending_) SolveAndSlide();
+}
+
+Prediction Smoother::PredictAt(double t) {
+  IntegrateTo(t);
+  const std::vector<BlockType> types = window_.EstimatedTypes();
+  Keyframe& newest = window_.back();
+  Prediction p;
+  // The newest keyframe's covariance: from the last solve, or predicted from the keyframe solved then.
+  MatX cov = newest_cov_;
+  if (newest.id != newest_cov_id_ && window_.size() >= 2 && newest.preint != nullptr) {
+    const Keyframe& solved = window_[window_.size() - 2];
+    cov = PredictBlockCovariance(types, newest_cov_, solved.State(), *newest.preint, options_);
+  }
+  if (t - newest.t > kSameEpoch && preint_->dt() > 0.0) {
+    p.x = pred_;
+    p.cov = PredictBlockCovariance(types, cov, newest.State(), *preint_, options_);
+  } else {
+    p.x = newest.State();
+    p.cov = cov;
+  }
+  return p;
+}
+
+Anchor Smoother::AnchorAt(double t) {
+  Keyframe& newest = window_.back();
+  if (std::abs(t - newest.t) <= kSameEpoch) return {&newest, nullptr};
+  IntegrateTo(t);
+  if (t - newest.t >= options_.smoother.min_keyframe_interval || preint_->dt() <= 0.0) {
+    Keyframe& kf = CreateKeyframe(t);
+    return {&kf, nullptr};
+  }
+  // A copy: the live preintegration goes on growing, a factor's must never change.
+  return {&newest, std::make_shared<const Preintegration>(*preint_)};
+}
+
+void Smoother::UpdateNewestCovariance(MatX* oldest_cov) {
+  const size_t n = window_.size();
+  std::vector<size_t> which;
+  if (oldest_cov != nullptr && n > 2) which.push_back(0);
+  if (n >= 2) which.push_back(n - 2);
+  which.push_back(n - 1);
+  MatX joint;
+  if (!KeyframesCovariance(window_, which, &joint)) return;  // keep the last good one
+  const int per = static_cast<int>(joint.rows()) / static_cast<int>(which.size());
+  const int m = static_cast<int>(which.size());
+  newest_cov_ = joint.bottomRightCorner(per, per);
+  newest_cov_id_ = window_.back().id;
+  if (n >= 2) {
+    newest_two_cov_ = joint.bottomRightCorner(2 * per, 2 * per);
+  } else {
+    newest_two_cov_.resize(0, 0);
+  }
+  if (oldest_cov != nullptr) *oldest_cov = joint.topLeftCorner(per, per);
+  (void)m;
+}
+
+void Smoother::RelievePrior(double factor) {
+  ++prior_reliefs_;
+  if (prior_id_ == nullptr || !(factor > 1.0)) return;
+  const auto* prior = dynamic_cast<const MarginalizationPrior*>(problem_->GetCostFunctionForResidualBlock(prior_id_));
+  if (prior == nullptr) return;
+  std::vector<double*> blocks;
+  problem_->GetParameterBlocksForResidualBlock(prior_id_, &blocks);
+  // The same prior with its covariance `factor` times larger: J and r0 scaled by 1/√factor.
+  const double s = 1.0 / std::sqrt(factor);
+  auto relieved = std::make_unique<MarginalizationPrior>(prior->blocks(), MatX(s * prior->J()), VecX(s * prior->r0()));
+  problem_->RemoveResidualBlock(prior_id_);
+  prior_id_ = problem_->AddResidualBlock(relieved.release(), nullptr, blocks);
+}
+
 ceres::ResidualBlockId Smoother::AddImuFactor(Keyframe& prev, Keyframe& kf) {
-  return window_.AddFactor(ImuFactor::Create(kf.preint, g_w_), nullptr,
+  // Gravity held over the interval: the model's at its middle (a metre of error there is 1e-6 m/s²).
+  ImuEarthTerms earth;
+  earth.g_w = earth_.Gravity(0.5 * (prev.State().p_wb + kf.State().p_wb));
+  earth.rate_w = earth_.rate_w();
+  return window_.AddFactor(ImuFactor::Create(kf.preint, earth), nullptr,
                            {{&prev, BlockType::kPose},
                             {&prev, BlockType::kVelocity},
                             {&prev, BlockType::kBias},
@@ -141,22 +244,28 @@ Keyframe& Smoother::CreateKeyframe(double t) {
 }
 
 void Smoother::AddStandstill(const StandstillMeasurement& m) {
-  if (!initialized_) return;
+  if (!initialized_ || m.t < window_.back().t) return;
+  if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
   for (auto& attacher : attachers_) attacher->OnStandstill(m, context_);
 }
 
 void Smoother::AddGvel(const GvelMeasurement& m) {
-  if (!initialized_) return;
-  for (auto& attacher : attachers_) attacher->OnGvel(m, context_);
+  if (!initialized_ || m.t < t_now_ - kSameEpoch || m.t < window_.back().t - kSameEpoch) return;
+  if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
+  bool attached = false;
+  for (auto& attacher : attachers_) attached = attacher->OnGvel(m, context_) || attached;
+  if (attached) solve_pending_ = true;
 }
 
 void Smoother::AddWheel(const WheelMeasurement& w) {
   if (!initialized_ || !options_.wheel.enabled) return;
+  IntegrateTo(w.t);
   for (auto& attacher : attachers_) attacher->OnWheel(w, context_);
 }
 
 void Smoother::AddGnss(const GnssMeasurement& m) {
-  if (!initialized_ || m.t < t_now_ - kSameEpoch) return;
+  if (!initialized_ || m.t < t_now_ - kSameEpoch || m.t < window_.back().t - kSameEpoch) return;
+  if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
   if (options_.watchdog.enabled) {
     const double max_sigma = options_.watchdog.max_position_sigma;
     const bool finite = window_.back().State().AllFinite() && pred_.AllFinite();
@@ -169,22 +278,12 @@ void Smoother::AddGnss(const GnssMeasurement& m) {
   reset_reason_.clear();
   const std::optional<GnssMeasurement> prev_fix = prev_fix_;
   prev_fix_ = m;
-  // Keyframe policy: a fix at the newest keyframe's epoch joins it; one sooner than
-  // smoother.min_keyframe_interval_s after it is dropped; any other makes a keyframe.
-  const double since_newest = m.t - window_.back().t;
-  if (std::abs(since_newest) > kSameEpoch) {
-    if (since_newest < options_.smoother.min_keyframe_interval) {
-      ++gnss_decimated_;
-      return;
-    }
-    CreateKeyframe(m.t);
-  }
   bool attached = false;
   for (auto& attacher : attachers_) attached = attacher->OnGnss(m, context_) || attached;
-  if (!attached) return;  // one fix per epoch
-  SolveAndSlide();
+  if (attached) solve_pending_ = true;
   if (!reset_reason_.empty()) {
     prev_fix_ = prev_fix;  // the fix before this one, for the velocity
+    SolveIfPending();
     ResetFromGnss(m, reset_reason_);
     prev_fix_ = m;
   }
@@ -205,7 +304,7 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
   const bool finite = window_.back().State().AllFinite();
   if (finite) {
     // The older keyframes leave the window as usual (final output); the newest is replaced by the prior.
-    while (window_.size() > 1) MarginalizeOldest();
+    while (window_.size() > 1) MarginalizeOldest(nullptr);
     have_cov = OldestCovariance(window_, &cov);
     init.x0 = at_fix.AllFinite() ? at_fix : window_.front().State();
     initial_scale_ = window_.front().block(BlockType::kScale)[0];
@@ -214,7 +313,8 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
     initial_scale_ = 1.0;
   }
   if (!have_cov) cov = FallbackCovariance(options_);
-  init.g_norm = g_w_.norm();
+  init.g_norm = earth_.g_norm();
+  init.earth = earth_;
   const bool have_velocity = ResetPositionFromFix(m, prev_fix_, options_, &init.x0, cov);
   // Tiny floors keep the prior invertible whatever the window's covariance was.
   cov = 0.5 * (cov + cov.transpose());
@@ -260,22 +360,35 @@ bool Smoother::Solve() {
 }
 
 void Smoother::SolveAndSlide() {
+  solve_pending_ = false;
   const auto t0 = std::chrono::steady_clock::now();
   const bool usable = Solve();
-  // The attachers' checks, each on the solution without what the previous ones took out.
-  for (auto& attacher : attachers_) {
-    if (attacher->AfterSolve(context_)) Solve();
-  }
   ReintegrateIfNeeded();
+  // One covariance recovery for the gates (the two newest keyframes) and, when the window slides, for the
+  // keyframe leaving it.
+  const bool slide = static_cast<int>(window_.size()) > options_.smoother.window_size;
+  MatX oldest_cov;
+  UpdateNewestCovariance(slide ? &oldest_cov : nullptr);
   const double dt = Seconds(std::chrono::steady_clock::now() - t0);
   ++solves_;
   solve_time_ += dt;
   max_solve_time_ = std::max(max_solve_time_, dt);
   if (!usable) ++solver_failures_;
 
-  pred_ = window_.back().State();
-  if (on_online_) on_online_(EstimateOf(window_.back(), nullptr));
-  while (static_cast<int>(window_.size()) > options_.smoother.window_size) MarginalizeOldest();
+  // The prediction to now starts again from the newest keyframe's solution.
+  const Keyframe& newest = window_.back();
+  pred_ = newest.State();
+  for (const HeldImuSample& step : interval_samples_) {
+    Kinematics k{pred_.q_wb, pred_.v_w, pred_.p_wb};
+    k = ImuStep(k, step.sample.gyro - pred_.bg, step.sample.acc - pred_.ba, g_w_, step.dt, nullptr, earth_.rate_w());
+    pred_.q_wb = k.q;
+    pred_.v_w = k.v;
+    pred_.p_wb = k.p;
+  }
+  pred_.t = t_now_;
+  if (on_online_) on_online_(EstimateOf(newest, nullptr));
+  if (slide) MarginalizeOldest(oldest_cov.size() > 0 ? &oldest_cov : nullptr);
+  while (static_cast<int>(window_.size()) > options_.smoother.window_size) MarginalizeOldest(nullptr);
 }
 
 void Smoother::ReintegrateIfNeeded() {
@@ -297,20 +410,26 @@ void Smoother::ReintegrateIfNeeded() {
   }
 }
 
-void Smoother::MarginalizeOldest() {
+void Smoother::MarginalizeOldest(const MatX* block_cov) {
   const auto t0 = std::chrono::steady_clock::now();
   Keyframe& kf0 = window_.front();
   const Keyframe* kf1 = window_.size() > 1 ? &window_[1] : nullptr;
 
   // Covariance of the keyframe leaving, from all the information in the window.
   Mat15 cov = Mat15::Zero();
-  const bool have_cov = OldestCovariance(window_, &cov);
+  bool have_cov = false;
+  if (block_cov != nullptr) {
+    cov = NavCovariance(window_.EstimatedTypes(), *block_cov);
+    have_cov = cov.allFinite();
+  } else {
+    have_cov = OldestCovariance(window_, &cov);
+  }
   // Schur complement of every factor touching the oldest keyframe.
   Marginalizer marginalizer(problem_.get(), window_.Blocks(kf0));
 
   if (have_cov) last_sigma_p_ = std::sqrt(cov.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
   OutputFinal(kf0, kf1, have_cov ? &cov : nullptr);
-  marginalizer.Apply();
+  prior_id_ = marginalizer.Apply();
   for (auto& attacher : attachers_) attacher->OnKeyframeLeaving(kf0);
   window_.PopOldest();
   if (!window_.empty()) {
@@ -323,13 +442,19 @@ void Smoother::MarginalizeOldest() {
 
 void Smoother::OutputFinal(const Keyframe& kf, const Keyframe* next, const Mat15* cov) {
   last_scale_ = kf.block(BlockType::kScale)[0];
-  if (on_final_) EmitFinal(kf, next, interval_samples_, cov, g_w_, on_final_);
+  if (on_final_) {
+    ImuEarthTerms earth;
+    earth.g_w = earth_.Gravity(kf.State().p_wb);
+    earth.rate_w = earth_.rate_w();
+    EmitFinal(kf, next, interval_samples_, cov, earth, on_final_);
+  }
 }
 
 void Smoother::Finish() {
   if (!initialized_) return;
+  SolveIfPending();
   // Everything still in the window leaves it now, oldest first.
-  while (window_.size() > 1) MarginalizeOldest();
+  while (window_.size() > 1) MarginalizeOldest(nullptr);
   Mat15 cov = Mat15::Zero();
   const bool have_cov = OldestCovariance(window_, &cov);
   OutputFinal(window_.front(), nullptr, have_cov ? &cov : nullptr);
@@ -350,7 +475,7 @@ nlohmann::json Smoother::Stats() const {
   j["marginalization_time_s"] = marg_time_;
   j["mean_marginalization_ms"] = marginalizations_ ? 1e3 * marg_time_ / marginalizations_ : 0.0;
   j["reintegrations"] = reintegrations_;
-  j["gnss_decimated"] = gnss_decimated_;
+  j["prior_reliefs"] = prior_reliefs_;
   for (const auto& attacher : attachers_) attacher->AddStats(&j);
   j["final_odom_scale"] = last_scale_;
   imu_gaps_.ToJson(&j);

@@ -1,26 +1,23 @@
-// Sliding-window smoother (reference ch. 4, DESIGN §7): keyframes at GNSS epochs (and every
-// smoother.max_keyframe_interval_s without GNSS), each with pose (7), velocity (3), biases (6) and the
-// odometer scale (1); IMU preintegration, bias and scale random-walk, GNSS (robust loss + χ² check),
-// heading, wheel-speed and zero-velocity factors; the oldest keyframe is marginalised by a Schur complement
-// of every factor touching it into a prior on what stays (factors/marginalization_prior.h).
+// Sliding-window smoother (reference ch. 4, DESIGN §7): keyframes at GNSS epochs at least
+// smoother.min_keyframe_interval_s apart (and every smoother.max_keyframe_interval_s without GNSS), each with
+// pose (7), velocity (3), biases (6) and the odometer scale (1) (solver/keyframe.h); IMU preintegration,
+// bias and scale random-walk factors between them; the measurements through their attachers
+// (solver/smoother_attachers.h, solver/vehicle_attacher.h): each checked against the window's prediction
+// at its own time (the innovation's χ² with the predicted marginal covariance) and attached at its own time
+// (at a keyframe, or through the IMU preintegrated from the newest one), so none is lost to keyframe
+// placement. All the measurements of one epoch join before one solve (the solve waits for the next IMU
+// sample). The oldest keyframe is marginalised by a Schur complement of every factor touching it into a
+// prior on what stays (solver/marginalizer.h), with first-estimate Jacobians from then on.
 //
-// Outputs: the final estimate of each keyframe when it leaves the window, with IMU-rate states between
-// keyframes propagated from it (final stream), and the newest keyframe after each solve (online stream).
-//
-// In parts: the keyframes and their state blocks (solver/keyframe.h), first-estimate Jacobians
-// (factors/fej_cost.h), one attacher per measurement type (solver/smoother_attachers.h), the marginaliser
-// (solver/marginalizer.h) and the output with covariance recovery (solver/smoother_output.h); this class
-// integrates the IMU, decides the keyframes, solves, and runs the watchdog.
+// Outputs: the final estimate of each keyframe when it leaves the window, with the IMU-rate states between
+// it and the next keyframe (solver/smoother_output.h), and the newest keyframe after each solve (online).
 //
 // Robustness (config standstill.*, watchdog.*, imu.max_gap_s):
-// - Standstill (AddStandstill, from the session's detector): a zero-velocity factor on each keyframe inside
-//   a standstill, and a zero-motion factor (no translation, 0.1 mm; no rotation, the gyro noise over the
-//   interval) between consecutive keyframes of one standstill, which with the IMU factor observes the gyro
-//   bias. A detection is ignored while the keyframe's speed is above standstill.max_speed_m_s.
+// - GNSS: a run of rejected fixes that agree with one another inflates the gate (GateInflation); a fix
+//   accepted under it also weakens the marginalisation prior by the same factor, so the window can move to
+//   where the fixes are (re-acquisition after an outage by design, not by the watchdog).
 // - IMU gap longer than imu.max_gap_s: preintegrated as a coast (no rotation, no acceleration from the
 //   current estimate) with the covariance of an unknown 2 m/s² and 10 deg/s held over the gap.
-// - GNSS: Cauchy loss, then a χ² check of each fix's residual after the solve; a failing fix is removed and
-//   the window solved again (counted, times listed).
 // - Watchdog: when every GNSS fix for watchdog.max_reject_s (at least 3) was rejected, or the last
 //   marginalised position 1-σ exceeds watchdog.max_position_sigma_m, or the newest state is not finite,
 //   the window is flushed to the output and rebuilt from a fresh prior at the current fix (position from
@@ -65,6 +62,16 @@ class Smoother : public Estimator {
  private:
   void IntegrateTo(double t, const ImuSample* held = nullptr);
   Keyframe& CreateKeyframe(double t);
+  // The attachers' services (AttachContext): the prediction at t, and the keyframe policy's anchor.
+  Prediction PredictAt(double t);
+  Anchor AnchorAt(double t);
+  // Solves the window if measurements joined it since the last solve.
+  void SolveIfPending();
+  // The joint covariance of the two newest keyframes (or the newest alone) after a solve.
+  // oldest_cov (optional): the oldest keyframe's too, from the same recovery.
+  void UpdateNewestCovariance(MatX* oldest_cov = nullptr);
+  // A fix was accepted under an inflated gate: the prior was overconfident by about `factor`.
+  void RelievePrior(double factor);
   ceres::ResidualBlockId AddImuFactor(Keyframe& prev, Keyframe& kf);
   void WatchGnss(double t, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
@@ -72,13 +79,15 @@ class Smoother : public Estimator {
   bool Solve();
   void SolveAndSlide();
   void ReintegrateIfNeeded();
-  void MarginalizeOldest();
+  // block_cov: the oldest keyframe's covariance (block order) if known, else recovered here.
+  void MarginalizeOldest(const MatX* block_cov);
   // A keyframe leaves the window: its final estimate and the IMU-rate states after it.
   void OutputFinal(const Keyframe& kf, const Keyframe* next, const Mat15* cov);
 
   EstimatorOptions options_;
   StateCallback on_final_, on_online_;
-  Vec3 g_w_ = Vec3::Zero();
+  EarthModel earth_;
+  Vec3 g_w_ = Vec3::Zero();  // gravity at the newest prediction (the attachers read it)
   bool initialized_ = false;
 
   KeyframeStore window_;
@@ -92,9 +101,15 @@ class Smoother : public Estimator {
   NavState pred_;  // IMU-propagated from the newest keyframe, for initial values
   double initial_scale_ = 1.0;  // odometer scale of the first keyframe (kept across a watchdog reset)
 
-  // The measurements' attachers, in the order of their checks after a solve.
+  // The measurements' attachers.
   std::vector<std::unique_ptr<MeasurementAttacher>> attachers_;
   AttachContext context_;
+  bool solve_pending_ = false;
+  // After the last solve: the covariance of the newest keyframe then (id newest_cov_id_), block order, and
+  // the joint one of it and the keyframe before it (older first; empty with one keyframe).
+  MatX newest_cov_, newest_two_cov_;
+  uint64_t newest_cov_id_ = 0;
+  ceres::ResidualBlockId prior_id_ = nullptr;  // the marginalisation (or initial) prior
 
   GnssWatchdog watchdog_;
   std::string reset_reason_;      // set by the checks, acted on at the end of AddGnss
@@ -104,7 +119,7 @@ class Smoother : public Estimator {
 
   // Statistics.
   uint64_t solves_ = 0, iterations_ = 0, marginalizations_ = 0, keyframes_ = 0, reintegrations_ = 0;
-  uint64_t gnss_decimated_ = 0, solver_failures_ = 0;
+  uint64_t solver_failures_ = 0, prior_reliefs_ = 0;
   double last_scale_ = 1.0;  // of the last keyframe to leave the window
   double solve_time_ = 0.0, max_solve_time_ = 0.0, marg_time_ = 0.0;
 };

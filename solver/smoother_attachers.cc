@@ -1,18 +1,18 @@
 #include "solver/smoother_attachers.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <limits>
 #include <utility>
 
 #include "core/chi2.h"
 #include "factors/gnss_factor.h"
 #include "factors/gvel_factor.h"
 #include "factors/heading_factor.h"
-#include "factors/nhc_factor.h"
-#include "factors/wheel_factor.h"
+#include "factors/preint_attached_factor.h"
 #include "factors/zero_motion_factor.h"
 #include "factors/zero_velocity_factor.h"
+#include "solver/smoother_gate.h"
 
 namespace gins {
 namespace {
@@ -21,126 +21,168 @@ namespace {
 // the last standstill detection (sent every 0.1 s) and still count as standing.
 constexpr double kStandstillPositionSigma = 1e-4;  // m
 constexpr double kStandstillReach = 0.15;          // s
-constexpr double kStandstillLossScale = 3.0;       // Cauchy loss scale on the whitened standstill residuals
-constexpr double kSameEpoch = 1e-6;                // s: a measurement at a keyframe's time belongs to it
 
-// Squared norm of a 3-dimensional residual block's residual, without its loss.
-double SquaredResidual(ceres::Problem* problem, ceres::ResidualBlockId id) {
-  double cost = 0.0;
-  Vec3 r;
-  problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, r.data(), nullptr);
-  return r.squaredNorm();
+// A state's blocks as values, to evaluate a factor at a predicted state before any keyframe holds it.
+struct StateBlocks {
+  std::array<double, pose::kAmbient> pose;
+  Vec3 vel;
+  Vec6 bias;
+  explicit StateBlocks(const NavState& x) : vel(x.v_w) {
+    SetPose(x.p_wb, x.q_wb, pose.data());
+    bias << x.bg, x.ba;
+  }
+};
+
+// The whitened innovation and its covariance back in the measurement's units, for GateInflation.
+void Unwhiten(const FactorCheck& c, const Vec3& sigma, Vec3* innovation, Mat3* S) {
+  *innovation = -c.residual.head<3>().cwiseProduct(sigma);
+  *S = sigma.asDiagonal() * Mat3(c.S.topLeftCorner<3, 3>()) * sigma.asDiagonal();
 }
 
 }  // namespace
 
-// --- GNSS velocity -------------------------------------------------------------------------------------------
+ImuEarthTerms AttachContext::EarthTermsAt(const Vec3& p_w) const {
+  ImuEarthTerms e;
+  e.g_w = earth.Gravity(p_w);
+  e.rate_w = earth.rate_w();
+  return e;
+}
 
-void GvelAttacher::OnGvel(const GvelMeasurement& m, const AttachContext& ctx) {
-  Keyframe& kf = ctx.keyframes.back();
-  if (std::abs(m.t - kf.t) > kSameEpoch) {
-    counts_.Reject("no_keyframe", m.t);
-    return;
-  }
-  const NavState x = kf.State();
-  const Vec3 omega_b = ctx.last_imu ? Vec3(ctx.last_imu->gyro - x.bg) : Vec3::Zero();
-  ctx.keyframes.AddFactor(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, options_.gnss.lever_b), nullptr,
-                          {{&kf, BlockType::kPose}, {&kf, BlockType::kVelocity}});
-  ++counts_.used;
+Vec3 AttachContext::BodyRate(const NavState& x) const {
+  return last_imu ? Vec3(last_imu->gyro - x.bg - x.q_wb.conjugate() * earth.rate_w()) : Vec3::Zero();
 }
 
 // --- GNSS -------------------------------------------------------------------------------------------------
 
-GnssAttacher::GnssAttacher(const EstimatorOptions& options, std::function<void(double, bool)> on_checked)
+GnssAttacher::GnssAttacher(const EstimatorOptions& options, std::function<void(double, bool)> on_checked,
+                           std::function<void(double)> on_reacquired)
     : options_(options),
       on_checked_(std::move(on_checked)),
-      gate_(Chi2Gate(options.gnss.gate_probability, 3)),
-      loss_(std::make_unique<ceres::CauchyLoss>(options.smoother.gnss_loss_scale)) {}
+      on_reacquired_(std::move(on_reacquired)),
+      gate_position_(Chi2Gate(options.gnss.gate_probability, 3)),
+      gate_heading_(Chi2Gate(options.gnss.gate_probability, 1)),
+      // A gate of +∞ (probability 0) leaves no corner: then no loss, as the ESKF has none.
+      loss_position_(std::isfinite(gate_position_) ? new ceres::HuberLoss(std::sqrt(gate_position_)) : nullptr),
+      loss_heading_(std::isfinite(gate_heading_) ? new ceres::HuberLoss(std::sqrt(gate_heading_)) : nullptr) {}
 
 bool GnssAttacher::OnGnss(const GnssMeasurement& m, const AttachContext& ctx) {
-  Keyframe& kf = ctx.keyframes.back();
-  Record& record = records_[kf.id];
-  if (record.position_id != nullptr) return false;  // one fix per epoch
-  record.position_id = ctx.keyframes.AddFactor(GnssFactor::Create(m.p_w, m.sigma_w, options_.gnss.lever_b), loss_.get(),
-                                               {{&kf, BlockType::kPose}});
-  if (m.heading_valid && options_.gnss.use_heading) {
-    ctx.keyframes.AddFactor(HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw), loss_.get(),
-                            {{&kf, BlockType::kPose}});
-    ++heading_counts_.used;
+  const Prediction pred = ctx.predict(m.t);
+  const bool position = AttachPosition(m, pred, ctx);
+  if (m.heading_valid && options_.gnss.use_heading) AttachHeading(m, ctx.predict(m.t), ctx);
+  return position;
+}
+
+bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx) {
+  const std::vector<BlockType> types = ctx.keyframes.EstimatedTypes();
+  const StateBlocks at(pred.x);
+  const std::unique_ptr<ceres::CostFunction> check_cost(GnssFactor::Create(m.p_w, m.sigma_w, options_.gnss.lever_b));
+  MatX sigma = SubCovariance(types, pred.cov, {BlockType::kPose});
+  const double inflation = inflation_.factor();
+  const FactorCheck plain = CheckFactor(*check_cost, {at.pose.data()}, {BlockKind::kPose}, sigma);
+  const FactorCheck check =
+      inflation > 1.0 ? CheckFactor(*check_cost, {at.pose.data()}, {BlockKind::kPose}, inflation * sigma) : plain;
+  if (!check.Passes(gate_position_)) {
+    position_counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
+    if (plain.evaluated) {
+      Vec3 innovation;
+      Mat3 S;
+      Unwhiten(plain, m.sigma_w, &innovation, &S);
+      inflation_.Rejected(m.t, innovation, S, gate_position_);
+    }
+    on_checked_(m.t, false);
+    return false;
   }
+  if (inflation > 1.0) {
+    inflation_.CountReacquired();
+    on_reacquired_(inflation);
+  }
+  inflation_.Accepted();
+  const Anchor a = ctx.anchor(m.t);
+  if (a.partial == nullptr) {
+    ctx.keyframes.AddFactor(GnssFactor::Create(m.p_w, m.sigma_w, options_.gnss.lever_b), loss_position_.get(),
+                            {{a.kf, BlockType::kPose}});
+  } else {
+    ctx.keyframes.AddFactor(
+        PreintAttachedFactor<GnssAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb),
+                                                 GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), options_.gnss.lever_b}),
+        loss_position_.get(), {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}});
+  }
+  ++position_counts_.used;
+  on_checked_(m.t, true);
   return true;
 }
 
-bool GnssAttacher::AfterSolve(const AttachContext& ctx) {
-  const Keyframe& kf = ctx.keyframes.back();
-  auto it = records_.find(kf.id);
-  if (it == records_.end()) return false;
-  Record& record = it->second;
-  if (record.position_id == nullptr || record.checked) return false;
-  record.checked = true;
-  if (SquaredResidual(ctx.keyframes.problem(), record.position_id) > gate_) {
-    // An outlier the robust loss only damped: take it out and solve again without it.
-    ctx.keyframes.problem()->RemoveResidualBlock(record.position_id);
-    record.position_id = nullptr;
-    position_counts_.Reject("chi2_gate", kf.t);
-    on_checked_(kf.t, false);
-    return true;
+void GnssAttacher::AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx) {
+  const std::vector<BlockType> types = ctx.keyframes.EstimatedTypes();
+  const StateBlocks at(pred.x);
+  const std::unique_ptr<ceres::CostFunction> check_cost(
+      HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw));
+  const FactorCheck check = CheckFactor(*check_cost, {at.pose.data()}, {BlockKind::kPose},
+                                        SubCovariance(types, pred.cov, {BlockType::kPose}));
+  if (!check.Passes(gate_heading_)) {
+    heading_counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
+    return;
   }
-  ++position_counts_.used;
-  on_checked_(kf.t, true);
-  return false;
+  const Anchor a = ctx.anchor(m.t);
+  if (a.partial == nullptr) {
+    ctx.keyframes.AddFactor(HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw),
+                            loss_heading_.get(), {{a.kf, BlockType::kPose}});
+  } else {
+    ctx.keyframes.AddFactor(
+        PreintAttachedFactor<HeadingAtTime>::Create(
+            a.partial, ctx.EarthTermsAt(pred.x.p_wb),
+            HeadingAtTime{m.yaw_G, 1.0 / m.sigma_yaw, options_.gnss.mount_yaw}),
+        loss_heading_.get(), {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}});
+  }
+  ++heading_counts_.used;
 }
 
 void GnssAttacher::AddStats(nlohmann::json* stats) const {
   (*stats)["gnss_position"] = position_counts_.ToJson();
   (*stats)["gnss_heading"] = heading_counts_.ToJson();
+  (*stats)["gnss_reacquired"] = inflation_.reacquired();
 }
 
-// --- Wheel ------------------------------------------------------------------------------------------------
+// --- GNSS velocity ----------------------------------------------------------------------------------------
 
-void WheelAttacher::OnWheel(const WheelMeasurement& m, const AttachContext& ctx) {
-  if (!options_.wheel.enabled) return;
-  last_wheel_ = m;
-  Attach(ctx.keyframes.back(), ctx);
-}
+GvelAttacher::GvelAttacher(const EstimatorOptions& options)
+    : options_(options),
+      gate_(Chi2Gate(options.gnss.gate_probability, 3)),
+      loss_(std::isfinite(gate_) ? new ceres::HuberLoss(std::sqrt(gate_)) : nullptr) {}
 
-void WheelAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
-  if (!options_.wheel.enabled || attached_to_ == kf.id || !last_wheel_) return;
-  const WheelMeasurement& w = *last_wheel_;
-  const double t_mid = w.t - 0.5 * w.interval;
-  const double offset = kf.t - t_mid;
-  if (std::abs(offset) > std::max(w.interval, 1e-3)) return;
-  attached_to_ = kf.id;
-  // The encoders give the mean speed over their interval; move it to the keyframe's time with the
-  // forward acceleration from the IMU.
-  double speed = w.speed;
-  if (ctx.last_imu) {
-    const NavState x = kf.State();
-    const Vec3 a_b = (ctx.last_imu->acc - x.ba) + x.q_wb.conjugate() * ctx.g_w;
-    speed += a_b.x() * offset;
+bool GvelAttacher::OnGvel(const GvelMeasurement& m, const AttachContext& ctx) {
+  const Prediction pred = ctx.predict(m.t);
+  const std::vector<BlockType> types = ctx.keyframes.EstimatedTypes();
+  const StateBlocks at(pred.x);
+  const Vec3 omega_b = ctx.BodyRate(pred.x);
+  const std::unique_ptr<ceres::CostFunction> check_cost(
+      GvelFactor::Create(m.v_w, m.sigma_w, omega_b, options_.gnss.lever_b));
+  const FactorCheck check = CheckFactor(*check_cost, {at.pose.data(), at.vel.data()},
+                                        {BlockKind::kPose, BlockKind::kEuclidean},
+                                        SubCovariance(types, pred.cov, {BlockType::kPose, BlockType::kVelocity}));
+  if (!check.Passes(gate_)) {
+    counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
+    return false;
   }
-  ctx.keyframes.AddFactor(WheelFactor::Create(speed, w.sigma), nullptr,
-                          {{&kf, BlockType::kPose}, {&kf, BlockType::kVelocity}, {&kf, BlockType::kScale}});
-  if (options_.wheel.nonholonomic) {
-    ctx.keyframes.AddFactor(NhcFactor::Create(options_.wheel.nhc_sigma), nullptr,
-                            {{&kf, BlockType::kPose}, {&kf, BlockType::kVelocity}});
+  const Anchor a = ctx.anchor(m.t);
+  if (a.partial == nullptr) {
+    ctx.keyframes.AddFactor(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, options_.gnss.lever_b), loss_.get(),
+                            {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}});
+  } else {
+    ctx.keyframes.AddFactor(
+        PreintAttachedFactor<GvelAtTime>::Create(
+            a.partial, ctx.EarthTermsAt(pred.x.p_wb),
+            GvelAtTime{m.v_w, m.sigma_w.cwiseInverse(), omega_b, options_.gnss.lever_b}),
+        loss_.get(), {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}});
   }
   ++counts_.used;
+  return true;
 }
-
-void WheelAttacher::AddStats(nlohmann::json* stats) const { (*stats)["wheel"] = counts_.ToJson(); }
 
 // --- Standstill -------------------------------------------------------------------------------------------
 
 StandstillAttacher::StandstillAttacher(const EstimatorOptions& options)
-    : options_(options),
-      gate_(Chi2Gate(options.wheel.gate_probability, 3)),  // standstill.* has no gate of its own: the wheel's
-      loss_(std::make_unique<ceres::CauchyLoss>(kStandstillLossScale)) {}
-
-const StandstillAttacher::Record* StandstillAttacher::Find(uint64_t id) const {
-  auto it = records_.find(id);
-  return it != records_.end() ? &it->second : nullptr;
-}
+    : options_(options), gate_(Chi2Gate(options.wheel.gate_probability, 3)) {}  // standstill.* has no gate
 
 void StandstillAttacher::OnStandstill(const StandstillMeasurement& m, const AttachContext& ctx) {
   last_ = m;
@@ -148,65 +190,43 @@ void StandstillAttacher::OnStandstill(const StandstillMeasurement& m, const Atta
 }
 
 void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
-  const Record* existing = Find(kf.id);
-  if (!last_ || (existing != nullptr && existing->standstill) || &kf != &ctx.keyframes.back()) return;
+  if (!last_ || standing_.count(kf.id) > 0 || &kf != &ctx.keyframes.back()) return;
   const StandstillMeasurement& s = *last_;
   if (kf.t < s.since || kf.t > s.t + kStandstillReach) return;
-  if (!StandstillPlausible(kf.State().v_w, options_.standstill)) {
+  const Prediction pred = ctx.predict(kf.t);
+  if (!StandstillPlausible(pred.x.v_w, options_.standstill)) {
     counts_.Reject("moving", kf.t);  // a quiet IMU at speed: not a stop
     return;
   }
-  Record& record = records_[kf.id];
-  record.standstill = true;
-  record.since = s.since;
-  // Robust like the GNSS factors, so that a wrong detection cannot bend the window to itself before the χ²
-  // check (AfterSolve) takes it out.
-  record.zupt_id = ctx.keyframes.AddFactor(new ZeroVelocityFactor(options_.standstill.velocity_sigma), loss_.get(),
-                                           {{&kf, BlockType::kVelocity}});
-}
-
-bool StandstillAttacher::AfterSolve(const AttachContext& ctx) {
-  // A quiet IMU during a smooth start or a constant acceleration can look like a stop: a zero velocity the
-  // other measurements disagree with (χ² on its whitened residual after the solve) is taken out again, and
-  // the window solved without it. (No zero-motion factor can be on it: those join confirmed ones only.)
-  KeyframeStore& keyframes = ctx.keyframes;
-  bool removed = false;
-  for (size_t i = 0; i < keyframes.size(); ++i) {
-    Keyframe& kf = keyframes[i];
-    auto it = records_.find(kf.id);
-    if (it == records_.end()) continue;
-    Record& record = it->second;
-    if (record.zupt_id == nullptr || record.checked) continue;
-    record.checked = true;
-    if (SquaredResidual(keyframes.problem(), record.zupt_id) <= gate_) {
-      ++counts_.used;
-      record.ok = true;
-      // Two confirmed keyframes of one standstill: no translation, no rotation in between. Not robust (its
-      // 0.1 mm would put any IMU disagreement in the flat part of a robust loss), so only between confirmed
-      // zero velocities; it joins at the next solve.
-      Keyframe* prev = i > 0 ? &keyframes[i - 1] : nullptr;
-      const Record* prev_record = prev != nullptr ? Find(prev->id) : nullptr;
-      if (prev_record != nullptr && prev_record->ok && prev->t >= record.since && !kf.still_from_prev) {
-        const double sigma_theta = std::max(2.0 * options_.imu.gyro_noise_density * std::sqrt(kf.t - prev->t), 1e-6);
-        ++zero_motion_factors_;
-        keyframes.AddFactor(ZeroMotionFactor::Create(kStandstillPositionSigma, sigma_theta), nullptr,
-                            {{prev, BlockType::kPose}, {&kf, BlockType::kPose}});
-        kf.still_from_prev = true;
-      }
-      continue;
-    }
+  // A quiet IMU during a smooth start or a constant acceleration can look like a stop: a zero velocity
+  // the predicted velocity disagrees with is not taken.
+  ZeroVelocityFactor check(options_.standstill.velocity_sigma);
+  const Vec3 v = pred.x.v_w;
+  const FactorCheck c = CheckFactor(check, {v.data()}, {BlockKind::kEuclidean},
+                                    SubCovariance(ctx.keyframes.EstimatedTypes(), pred.cov, {BlockType::kVelocity}));
+  if (!c.Passes(gate_)) {
     counts_.Reject("chi2_gate", kf.t);
-    keyframes.problem()->RemoveResidualBlock(record.zupt_id);
-    record.zupt_id = nullptr;
-    record.standstill = false;
-    removed = true;
+    return;
   }
-  return removed;
+  ctx.keyframes.AddFactor(new ZeroVelocityFactor(options_.standstill.velocity_sigma), nullptr,
+                          {{&kf, BlockType::kVelocity}});
+  ++counts_.used;
+  standing_[kf.id] = s.since;
+  // Two keyframes of one standstill: no translation, no rotation in between (its 0.1 mm would put any IMU
+  // disagreement in the flat part of a robust loss, so only between accepted zero velocities).
+  if (ctx.keyframes.size() < 2) return;
+  Keyframe& prev = ctx.keyframes[ctx.keyframes.size() - 2];
+  if (standing_.count(prev.id) == 0 || prev.t < s.since || kf.still_from_prev) return;
+  const double sigma_theta = std::max(2.0 * options_.imu.gyro_noise_density * std::sqrt(kf.t - prev.t), 1e-6);
+  ++zero_motion_factors_;
+  ctx.keyframes.AddFactor(ZeroMotionFactor::Create(kStandstillPositionSigma, sigma_theta), nullptr,
+                          {{&prev, BlockType::kPose}, {&kf, BlockType::kPose}});
+  kf.still_from_prev = true;
 }
 
 void StandstillAttacher::OnWindowRebuilt() {
+  standing_.clear();
   last_.reset();
-  records_.clear();
 }
 
 void StandstillAttacher::AddStats(nlohmann::json* stats) const {

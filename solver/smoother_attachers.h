@@ -1,17 +1,24 @@
 // How measurements become factors in the smoother's window: one attacher per measurement type behind one
-// interface, called by the smoother at fixed moments. A new measurement type (GNSS velocity, an odometer
-// integrating every wheel reading, NHC at its own rate, ...) is a new attacher added to the smoother's list;
-// the others do not change.
+// interface, called by the smoother at fixed moments. A new measurement type is a new attacher added to the
+// smoother's list; the others do not change.
+//
+// Every measurement is first checked against what the window predicts at its time (solver/smoother_gate.h:
+// the innovation's χ² with S = H·P·Hᵀ + R, P the predicted state's marginal covariance from the whole
+// window), as the ESKF does; one that passes is attached at full weight, at its own time (at a keyframe of
+// its epoch, or through the IMU preintegrated from the newest keyframe: factors/preint_attached_factor.h),
+// so no measurement is lost to keyframe placement. The robust loss on GNSS factors is a Huber loss whose
+// corner is the gate itself: every residual the gate accepts is inside its quadratic part (full weight);
+// it only bounds the pull of a measurement the solution later moves away from.
 //
 // The attachers here:
-// - GnssAttacher: position (Cauchy loss) and dual-antenna heading on the keyframe at the fix's epoch; after
-//   the solve a χ² check of the position residual, a failing fix removed and the window solved again.
-// - WheelAttacher: the wheel speed (moved to the keyframe's time with the IMU's forward acceleration) and,
-//   if configured, the non-holonomic constraint, on the newest keyframe within the reading's interval.
+// - GnssAttacher: position and dual-antenna heading; a run of rejected fixes that agree with one another
+//   inflates the gate (GateInflation, solver/estimator.h), and a fix accepted under it relieves the prior.
+// - GvelAttacher: GNSS (Doppler) velocity.
 // - StandstillAttacher: from the session's detector, a zero-velocity factor on each keyframe inside a
-//   standstill (not above standstill.max_speed_m_s), checked by χ² after the solve; a zero-motion factor (no
-//   translation, 0.1 mm; no rotation, the gyro noise over the interval) between consecutive confirmed
-//   keyframes of one standstill, which with the IMU factor observes the gyro bias.
+//   standstill (checked against the predicted velocity, not above standstill.max_speed_m_s), and a
+//   zero-motion factor (no translation, 0.1 mm; no rotation, the gyro noise over the interval) between
+//   consecutive such keyframes, which with the IMU factor observes the gyro bias.
+// The vehicle's own constraints and the wheels are solver/vehicle_attacher.h's.
 #pragma once
 
 #include <ceres/loss_function.h>
@@ -20,38 +27,61 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "core/earth.h"
 #include "solver/estimator.h"
 #include "solver/keyframe.h"
 
 namespace gins {
 
-// What the smoother lends an attacher: the window (its problem, factors with first-estimate Jacobians) and
-// what it needs of the IMU stream.
+// What the window predicts at a time t (≥ the newest keyframe's): the state, and the covariance of its
+// blocks' tangents (KeyframeStore::EstimatedTypes order) from everything in the window before t.
+struct Prediction {
+  NavState x;
+  MatX cov;
+};
+
+// Where a measurement at t attaches: a keyframe, and the IMU preintegrated from it to t (null at its time).
+struct Anchor {
+  Keyframe* kf = nullptr;
+  std::shared_ptr<const Preintegration> partial;
+};
+
+// What the smoother lends an attacher: the window (its problem, factors with first-estimate Jacobians), the
+// options, the Earth, the IMU stream, and its services.
 struct AttachContext {
   KeyframeStore& keyframes;
-  const Vec3& g_w;                           // gravity in w
-  const std::optional<ImuSample>& last_imu;  // the latest IMU sample, if any
+  const EstimatorOptions& options;
+  const EarthModel& earth;
+  const std::optional<ImuSample>& last_imu;
+  std::function<Prediction(double t)> predict;
+  // Applies the keyframe policy for a measurement at t: the newest keyframe if t is its epoch, a new
+  // keyframe at t if it is at least smoother.min_keyframe_interval_s later, else the newest keyframe and
+  // the IMU preintegrated from it to t.
+  std::function<Anchor(double t)> anchor;
+  // After the last solve: the joint covariance of the two newest keyframes (older first), or null.
+  std::function<const MatX*()> newest_two_cov;
+  // The Earth terms of an IMU interval around p (gravity there, Earth rate).
+  ImuEarthTerms EarthTermsAt(const Vec3& p_w) const;
+  // The body's rate against w from the last IMU sample, with the biases of x.
+  Vec3 BodyRate(const NavState& x) const;
 };
 
 class MeasurementAttacher {
  public:
   virtual ~MeasurementAttacher() = default;
 
-  // A measurement arrived (the smoother is initialised). For GNSS the smoother's keyframe policy has run:
-  // the newest keyframe is at the fix's epoch; returns true if a factor was attached (the window is then
-  // solved).
+  // A measurement arrived (the smoother is initialised); true if a factor was attached (the window is
+  // then solved before the next IMU sample).
   virtual bool OnGnss(const GnssMeasurement& /*m*/, const AttachContext& /*ctx*/) { return false; }
+  virtual bool OnGvel(const GvelMeasurement& /*m*/, const AttachContext& /*ctx*/) { return false; }
   virtual void OnWheel(const WheelMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
   virtual void OnStandstill(const StandstillMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
-  virtual void OnGvel(const GvelMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
   // A keyframe became the newest, with its IMU and random-walk factors.
   virtual void OnKeyframeCreated(Keyframe& /*kf*/, const AttachContext& /*ctx*/) {}
-  // After a solve, in attacher order: the checks of what was attached. True if the problem changed, so
-  // that the window must be solved again before the next attacher's check.
-  virtual bool AfterSolve(const AttachContext& /*ctx*/) { return false; }
   // The oldest keyframe leaves the window; its factors are gone already.
   virtual void OnKeyframeLeaving(const Keyframe& /*kf*/) {}
   // The watchdog rebuilt the window from a fresh prior: nothing attached before is in it.
@@ -62,59 +92,38 @@ class MeasurementAttacher {
 
 class GnssAttacher final : public MeasurementAttacher {
  public:
-  // on_checked(t, accepted): each fix's outcome of the χ² check, for the smoother's watchdog.
-  GnssAttacher(const EstimatorOptions& options, std::function<void(double t, bool accepted)> on_checked);
+  // on_checked(t, accepted): each fix's outcome, for the smoother's watchdog; on_reacquired(factor): a fix
+  // was accepted under an inflated gate (the window was overconfident by about that factor).
+  GnssAttacher(const EstimatorOptions& options, std::function<void(double t, bool accepted)> on_checked,
+               std::function<void(double factor)> on_reacquired);
 
   bool OnGnss(const GnssMeasurement& m, const AttachContext& ctx) override;
-  bool AfterSolve(const AttachContext& ctx) override;
-  void OnKeyframeLeaving(const Keyframe& kf) override { records_.erase(kf.id); }
-  void OnWindowRebuilt() override { records_.clear(); }
+  void OnWindowRebuilt() override { inflation_.Accepted(); }
   void AddStats(nlohmann::json* stats) const override;
 
  private:
-  struct Record {
-    ceres::ResidualBlockId position_id = nullptr;
-    bool checked = false;
-  };
+  bool AttachPosition(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
+  void AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
+
   EstimatorOptions options_;
   std::function<void(double, bool)> on_checked_;
-  double gate_;  // χ² gate on the whitened position residual (3 dof)
-  std::unique_ptr<ceres::LossFunction> loss_;
-  std::map<uint64_t, Record> records_;  // by keyframe id
+  std::function<void(double)> on_reacquired_;
+  double gate_position_, gate_heading_;
+  std::unique_ptr<ceres::LossFunction> loss_position_, loss_heading_;
+  GateInflation inflation_;
   MeasurementCounts position_counts_, heading_counts_;
 };
 
-class WheelAttacher final : public MeasurementAttacher {
- public:
-  explicit WheelAttacher(const EstimatorOptions& options) : options_(options) {}
-
-  void OnWheel(const WheelMeasurement& m, const AttachContext& ctx) override;
-  void OnKeyframeCreated(Keyframe& kf, const AttachContext& ctx) override { Attach(kf, ctx); }
-  // The last reading is kept across a rebuild: the new keyframe may take it.
-  void OnWindowRebuilt() override { attached_to_.reset(); }
-  void AddStats(nlohmann::json* stats) const override;
-
- private:
-  void Attach(Keyframe& kf, const AttachContext& ctx);
-
-  EstimatorOptions options_;
-  std::optional<WheelMeasurement> last_wheel_;
-  // The keyframe with the wheel factor, if any. Factors go to the newest keyframe only, so one id is all
-  // the memory needed.
-  std::optional<uint64_t> attached_to_;
-  MeasurementCounts counts_;
-};
-
-// GNSS velocity on the keyframe of its epoch (made for the fix of that epoch); without one it is not used
-// (counted: no_keyframe).
 class GvelAttacher final : public MeasurementAttacher {
  public:
-  explicit GvelAttacher(const EstimatorOptions& options) : options_(options) {}
-  void OnGvel(const GvelMeasurement& m, const AttachContext& ctx) override;
+  explicit GvelAttacher(const EstimatorOptions& options);
+  bool OnGvel(const GvelMeasurement& m, const AttachContext& ctx) override;
   void AddStats(nlohmann::json* stats) const override { (*stats)["gnss_velocity"] = counts_.ToJson(); }
 
  private:
   EstimatorOptions options_;
+  double gate_;
+  std::unique_ptr<ceres::LossFunction> loss_;
   MeasurementCounts counts_;
 };
 
@@ -124,28 +133,18 @@ class StandstillAttacher final : public MeasurementAttacher {
 
   void OnStandstill(const StandstillMeasurement& m, const AttachContext& ctx) override;
   void OnKeyframeCreated(Keyframe& kf, const AttachContext& ctx) override { Attach(kf, ctx); }
-  bool AfterSolve(const AttachContext& ctx) override;
-  void OnKeyframeLeaving(const Keyframe& kf) override { records_.erase(kf.id); }
+  void OnKeyframeLeaving(const Keyframe& kf) override { standing_.erase(kf.id); }
   // A standstill detected before the rebuild is not carried into the new window.
   void OnWindowRebuilt() override;
   void AddStats(nlohmann::json* stats) const override;
 
  private:
-  struct Record {
-    bool standstill = false;  // has a zero-velocity factor
-    double since = 0.0;       // start of its standstill
-    ceres::ResidualBlockId zupt_id = nullptr;
-    bool checked = false;
-    bool ok = false;  // its zero velocity passed the χ² check
-  };
   void Attach(Keyframe& kf, const AttachContext& ctx);
-  const Record* Find(uint64_t id) const;
 
   EstimatorOptions options_;
-  double gate_;  // χ² gate on the whitened zero-velocity residual (3 dof)
-  std::unique_ptr<ceres::LossFunction> loss_;
+  double gate_;  // χ² gate on the zero velocity (3 dof)
   std::optional<StandstillMeasurement> last_;
-  std::map<uint64_t, Record> records_;  // by keyframe id
+  std::map<uint64_t, double> standing_;  // keyframes with an accepted zero velocity: the start of their stop
   MeasurementCounts counts_;
   uint64_t zero_motion_factors_ = 0;
 };

@@ -54,12 +54,55 @@ bool LeadingCovariance(ceres::Problem* problem, const std::vector<double*>& bloc
   return cov->allFinite();
 }
 
+bool KeyframesCovariance(KeyframeStore& store, const std::vector<size_t>& keyframes, MatX* cov) {
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = store.EstimatedBlocks();
+  ceres::CRSMatrix J;
+  if (!store.problem()->Evaluate(eo, nullptr, nullptr, nullptr, &J)) return false;
+  int per_keyframe = 0;
+  for (BlockType t : store.EstimatedTypes()) per_keyframe += SpecOf(t).tangent_size;
+  if (J.num_cols != per_keyframe * static_cast<int>(store.size())) return false;
+  using SpMat = Eigen::SparseMatrix<double>;
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor, int>> Js(
+      J.num_rows, J.num_cols, static_cast<Eigen::Index>(J.values.size()), J.rows.data(), J.cols.data(),
+      J.values.data());
+  const SpMat H = SpMat(Js.transpose()) * Js;
+  const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(H);
+  if (ldlt.info() != Eigen::Success) return false;
+  std::vector<int> columns;
+  for (size_t k : keyframes) {
+    for (int i = 0; i < per_keyframe; ++i) columns.push_back(static_cast<int>(k) * per_keyframe + i);
+  }
+  const int m = static_cast<int>(columns.size());
+  MatX E = MatX::Zero(H.rows(), m);
+  for (int i = 0; i < m; ++i) E(columns[i], i) = 1.0;
+  const MatX C = ldlt.solve(E);
+  if (ldlt.info() != Eigen::Success) return false;
+  cov->resize(m, m);
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < m; ++j) (*cov)(i, j) = C(columns[i], j);
+  }
+  *cov = 0.5 * (*cov + cov->transpose());
+  return cov->allFinite();
+}
+
+Mat15 NavCovariance(const std::vector<BlockType>& types, const MatX& block_cov) {
+  const std::vector<int> nav = NavIndexOfTangent(types);
+  Mat15 P = Mat15::Zero();
+  for (size_t i = 0; i < nav.size(); ++i) {
+    for (size_t j = 0; j < nav.size(); ++j) {
+      if (nav[i] >= 0 && nav[j] >= 0) P(nav[i], nav[j]) = block_cov(i, j);
+    }
+  }
+  return P;
+}
+
 bool OldestCovariance(KeyframeStore& store, Mat15* cov) {
   return LeadingCovariance(store.problem(), store.EstimatedBlocks(), NavIndexOfTangent(store.EstimatedTypes()), cov);
 }
 
 void EmitFinal(const Keyframe& kf, const Keyframe* next, const std::vector<HeldImuSample>& tail, const Mat15* cov,
-               const Vec3& g_w, const StateCallback& on_final) {
+               const ImuEarthTerms& earth, const StateCallback& on_final) {
   const StateEstimate e = EstimateOf(kf, cov);
   on_final(e);
   // IMU-rate states to the next keyframe, propagated from this keyframe's final estimate.
@@ -71,7 +114,9 @@ void EmitFinal(const Keyframe& kf, const Keyframe* next, const std::vector<HeldI
   double t = e.x.t;
   for (size_t i = 0; i < steps.size(); ++i) {
     const HeldImuSample& step = steps[i];
-    if (!standing) k = ImuStep(k, step.sample.gyro - e.x.bg, step.sample.acc - e.x.ba, g_w, step.dt);
+    if (!standing) {
+      k = ImuStep(k, step.sample.gyro - e.x.bg, step.sample.acc - e.x.ba, earth.g_w, step.dt, nullptr, earth.rate_w);
+    }
     t += step.dt;
     if (next != nullptr && i + 1 == steps.size()) break;  // the next keyframe emits itself
     StateEstimate m = e;

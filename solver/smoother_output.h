@@ -22,10 +22,23 @@ bool LeadingCovariance(ceres::Problem* problem, const std::vector<double*>& bloc
 // Covariance of the oldest keyframe of the window, from all the information in the window.
 bool OldestCovariance(KeyframeStore& store, Mat15* cov);
 
+// Joint covariance of the estimated blocks of some keyframes of the window (indices, 0 = oldest), in
+// KeyframeStore::EstimatedTypes order, keyframe after keyframe, from all the information in the window.
+bool KeyframesCovariance(KeyframeStore& store, const std::vector<size_t>& keyframes, MatX* cov);
+// The same in NavState tangent order (15) for one keyframe's block-order covariance (scale left out).
+Mat15 NavCovariance(const std::vector<BlockType>& types, const MatX& block_cov);
+
 // The final stream of one keyframe: its estimate, then the IMU-rate states up to the next keyframe
 // (excluded: it emits itself), propagated from this keyframe's final estimate through next's
 // steps_from_prev; without a next keyframe, through all of `tail` (the steps after the newest keyframe).
 void EmitFinal(const Keyframe& kf, const Keyframe* next, const std::vector<HeldImuSample>& tail, const Mat15* cov,
-               const Vec3& g_w, const StateCallback& on_final);
+               const ImuEarthTerms& earth, const StateCallback& on_final);
+// On the flat Earth with gravity g_w.
+inline void EmitFinal(const Keyframe& kf, const Keyframe* next, const std::vector<HeldImuSample>& tail,
+                      const Mat15* cov, const Vec3& g_w, const StateCallback& on_final) {
+  ImuEarthTerms earth;
+  earth.g_w = g_w;
+  EmitFinal(kf, next, tail, cov, earth, on_final);
+}
 
 }  // namespace gins

@@ -106,7 +106,7 @@ struct SimOptions {
   double wheel_radius = 0.155, pulses_per_rev = 1024.0, wheel_scale = 0.99, wheel_speed_noise = 0.02;
   double track_width = 1.6;
   // Physics and field-log set-ups (header comment).
-  bool earth_rotation = false;              // the rotating Earth model; false: flat
+  bool earth_rotation = true;               // the rotating Earth model; false: flat
   Vec3 gnss_velocity_sigma = Vec3::Zero();  // m/s per ENU axis; all zero: no GVEL records
   double gnss_noise_correlation = 0.0;      // s, τ of the GNSS position noise; 0: white
   double log_start = 0.0;                   // s after start_time before which nothing is logged

@@ -83,8 +83,9 @@ std::string Sci(double v) {
 // A drive like cli_test's (10 s standstill, accelerating, a left turn, a cruise), at 200 Hz like i2Nav's
 // IMUs, in GPS seconds of week; its wheel records are dropped (i2Nav files have none). Converted logs carry no heading:
 // the run takes its yaw from the motion.
-constexpr const char* kConfig = R"(# convert_cli_test
+constexpr const char* kConfig = R"(# convert_cli_test: the conversion round trip, on the flat Earth (tests/solver cover the Earth model)
 simulate:
+  earth_rotation: false
   seed: 7
   start_time_s: 357000
   origin: [30.46, 114.47, 23.0]
@@ -99,6 +100,8 @@ simulate:
 init:
   wait_for_heading: false
   sigma_yaw_deg: 180
+gravity:
+  earth_rotation: false
 )";
 
 // Writes a gins log's IMU and GNSS records as i2Nav files: increments over (t_prev, t] by the trapezoid

@@ -119,11 +119,11 @@ void CheckAllUsed(benchmark::State& state, const nlohmann::json& counts, uint64_
   }
 }
 
-// Wheel-speed update; with nhc:1 also the non-holonomic update (wheel.nonholonomic), applied with it.
+// Wheel-speed update; with nhc:1 also the non-holonomic update (vehicle.nonholonomic), applied with it.
 void BM_EskfWheelUpdate(benchmark::State& state) {
   const bool nhc = state.range(0) != 0;
   Options options = test::TestRunOptions(test::TestDrive(1));
-  options.wheel.nonholonomic = nhc;
+  options.vehicle.nonholonomic = nhc;
   EskfFixture f(options);
   const uint64_t used0 = f.eskf()->Stats()["wheel"]["used"].get<uint64_t>();
   WheelMeasurement w;

@@ -7,7 +7,6 @@
 #include <cctype>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -32,24 +31,38 @@ struct Line {
   std::string path;  // of a key: "section" or "section.key"
 };
 
+// A key line: up to two spaces, a name of [A-Za-z0-9_], a colon, then nothing or white space and a value.
+// Hand-parsed: std::regex trips GCC 12's -Wmaybe-uninitialized in the sanitizer build (-O1 -Werror).
+bool ParseKeyLine(const std::string& s, size_t* indent, std::string* name) {
+  const size_t first = s.find_first_not_of(' ');
+  if (first == std::string::npos || first > 2) return false;
+  size_t end = first;
+  while (end < s.size() && (std::isalnum(static_cast<unsigned char>(s[end])) != 0 || s[end] == '_')) ++end;
+  if (end == first || end >= s.size() || s[end] != ':') return false;
+  if (end + 1 < s.size() && std::isspace(static_cast<unsigned char>(s[end + 1])) == 0) return false;
+  *indent = first;
+  *name = s.substr(first, end - first);
+  return true;
+}
+
 std::vector<Line> Classify(const std::string& text) {
-  static const std::regex kKeyLine(R"(^( *)([A-Za-z0-9_]+):(\s.*)?$)");
   std::vector<Line> lines;
   std::istringstream in(text);
   std::string section;
   for (std::string s; std::getline(in, s);) {
     Line line;
     line.text = s;
-    std::smatch m;
     const size_t first = s.find_first_not_of(' ');
+    size_t indent = 0;
+    std::string name;
     if (first == std::string::npos) {
       line.kind = Line::Kind::kBlank;
     } else if (s[first] == '#') {
       line.kind = Line::Kind::kComment;
-    } else if (std::regex_match(s, m, kKeyLine) && m[1].length() <= 2) {
+    } else if (ParseKeyLine(s, &indent, &name)) {
       line.kind = Line::Kind::kKey;
-      if (m[1].length() == 0) section = m[2];
-      line.path = m[1].length() == 0 ? section : section + "." + m[2].str();
+      if (indent == 0) section = name;
+      line.path = indent == 0 ? section : section + "." + name;
     }
     lines.push_back(line);
   }

@@ -97,8 +97,12 @@ Comparison Compare(const Options& a, const Options& b) {
   GINS_FIELD(wheel.scale_sigma);
   GINS_FIELD(wheel.scale_rw);
   GINS_FIELD(wheel.estimate_scale);
-  GINS_FIELD(wheel.nonholonomic);
-  GINS_FIELD(wheel.nhc_sigma);
+  GINS_FIELD(wheel.lever_b);
+  GINS_FIELD(wheel.track);
+  GINS_FIELD(vehicle.nonholonomic);
+  GINS_FIELD(vehicle.nhc_sigma);
+  GINS_FIELD(vehicle.nhc_rate);
+  GINS_FIELD(gravity.earth_rotation);
   GINS_FIELD(gravity.use_normal_gravity);
   GINS_FIELD(gravity.magnitude);
   GINS_FIELD(init.static_duration);
@@ -208,8 +212,12 @@ Options NonDefaultOptions() {
   o.wheel.scale_sigma = 0.02;
   o.wheel.scale_rw = 3e-5;
   o.wheel.estimate_scale = false;
-  o.wheel.nonholonomic = true;
-  o.wheel.nhc_sigma = 0.3;
+  o.wheel.lever_b = Vec3(-1.5, 0.0, -0.3);
+  o.wheel.track = 1.55;
+  o.vehicle.nonholonomic = false;
+  o.vehicle.nhc_sigma = 0.3;
+  o.vehicle.nhc_rate = 5.0;
+  o.gravity.earth_rotation = false;
   o.gravity.use_normal_gravity = false;
   o.gravity.magnitude = 9.7936;
   o.init.static_duration = 5.0;
@@ -468,13 +476,13 @@ TEST(ConfigLoaderTest, ZeroDisablesGates) {
 TEST(ConfigLoaderTest, EnumsAndBooleans) {
   const Options o = Load(
       "input: {on_error: stop}\ngravity: {model: fixed, magnitude_m_s2: 9.8}\n"
-      "smoother: {linear_solver: dense_schur}\nwheel: {enabled: false, nonholonomic: true}");
+      "smoother: {linear_solver: dense_schur}\nwheel: {enabled: false}\nvehicle: {nonholonomic: false}");
   EXPECT_EQ(o.input.on_error, InputErrorPolicy::kStop);
   EXPECT_FALSE(o.gravity.use_normal_gravity);
   EXPECT_EQ(o.gravity.magnitude, 9.8);
   EXPECT_EQ(o.smoother.linear_solver, "dense_schur");
   EXPECT_FALSE(o.wheel.enabled);
-  EXPECT_TRUE(o.wheel.nonholonomic);
+  EXPECT_FALSE(o.vehicle.nonholonomic);
 }
 
 // ---- Errors ------------------------------------------------------------------------------------------------

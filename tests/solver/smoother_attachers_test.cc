@@ -1,5 +1,6 @@
-// The measurement attachers on a window of their own: what each attaches, to which keyframe, and what its
-// check after a solve keeps, removes and counts.
+// The measurement attachers on a window of their own, with the smoother's services stubbed: what each
+// checks against the prediction, what it attaches and where (a keyframe of its epoch or through the IMU
+// preintegrated from the newest keyframe), and what it counts.
 #include "solver/smoother_attachers.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "core/so3.h"
+#include "solver/vehicle_attacher.h"
 #include "window_test_util.h"
 
 namespace gins {
@@ -16,25 +18,45 @@ namespace {
 
 class AttacherTest : public ::testing::Test {
  protected:
-  AttacherTest() : problem_(test::SmootherProblemOptions()), store_(options_), context_{store_, g_w_, last_imu_} {
+  AttacherTest()
+      : problem_(test::SmootherProblemOptions()),
+        store_(options_),
+        context_{store_,
+                 options_,
+                 earth_,
+                 last_imu_,
+                 [this](double t) { return Predict(t); },
+                 [this](double t) { return Anchor(t); },
+                 [this]() -> const MatX* { return two_.size() > 0 ? &two_ : nullptr; }} {
     options_.gnss.lever_b = Vec3::Zero();
+    options_.wheel.lever_b = Vec3::Zero();
     store_.Reset(&problem_);
   }
-  // A keyframe at t, level with yaw 0 (body x east), moving at `speed` along x.
+  // A keyframe at t, level with yaw 0 (body x east), moving at `speed` along x from x = 10·t.
   Keyframe& Push(double t, double speed) {
     NavState x;
     x.t = t;
     x.p_wb = Vec3(10.0 * t, 0.0, 0.0);
     x.v_w = Vec3(speed, 0.0, 0.0);
-    return store_.Push(store_.Make(t, x));
+    Keyframe& kf = store_.Push(store_.Make(t, x));
+    return kf;
+  }
+  // The prediction stub: the newest keyframe, with a diagonal covariance of position σ_p.
+  Prediction Predict(double /*t*/) {
+    Prediction p;
+    p.x = store_.back().State();
+    const int n = static_cast<int>(NavIndexOfTangent(store_.EstimatedTypes()).size());
+    p.cov = MatX::Identity(n, n) * 1e-6;
+    p.cov.topLeftCorner<3, 3>() = Mat3::Identity() * sigma_p_ * sigma_p_;
+    return p;
+  }
+  // The anchor stub: the newest keyframe at its epoch, else (when allowed) a new keyframe at t.
+  gins::Anchor Anchor(double t) {
+    ++anchors_;
+    if (std::abs(t - store_.back().t) < 1e-6) return {&store_.back(), nullptr};
+    return {&Push(t, 10.0), nullptr};
   }
   int Residuals() const { return problem_.NumResidualBlocks(); }
-  double SquaredResidual(ceres::ResidualBlockId id) {
-    double cost = 0.0;
-    VecX r(problem_.GetCostFunctionForResidualBlock(id)->num_residuals());
-    problem_.EvaluateResidualBlock(id, false, &cost, r.data(), nullptr);
-    return r.squaredNorm();
-  }
   nlohmann::json Stats(const MeasurementAttacher& a) const {
     nlohmann::json j;
     a.AddStats(&j);
@@ -44,10 +66,99 @@ class AttacherTest : public ::testing::Test {
   EstimatorOptions options_ = test::WindowOptions(true);
   ceres::Problem problem_;
   KeyframeStore store_;
-  Vec3 g_w_ = GravityWorld(9.81);
+  EarthModel earth_ = EarthModel(9.81);
   std::optional<ImuSample> last_imu_;
+  double sigma_p_ = 0.05;
+  MatX two_;
+  int anchors_ = 0;
   AttachContext context_;
 };
+
+GnssMeasurement Fix(double t, const Vec3& p_w) {
+  GnssMeasurement m;
+  m.t = t;
+  m.p_w = p_w;
+  m.sigma_w = Vec3::Constant(0.02);
+  return m;
+}
+
+TEST_F(AttacherTest, GnssFixIsCheckedAgainstThePredictionAndAttachedAtItsEpoch) {
+  Push(10.0, 10.0);  // at (100, 0, 0), σ_p 5 cm
+  std::vector<std::pair<double, bool>> outcomes;
+  GnssAttacher gnss(options_, [&](double t, bool ok) { outcomes.emplace_back(t, ok); }, [](double) {});
+  // 10 cm off: innovation χ² ≈ 0.1²/(0.05² + 0.02²) ≈ 3.4: accepted, at full weight.
+  EXPECT_TRUE(gnss.OnGnss(Fix(10.0, Vec3(100.1, 0.0, 0.0)), context_));
+  EXPECT_EQ(Residuals(), 1);
+  // 1 m off: χ² ≈ 345, far beyond the 3-dof gate (21.1): rejected, nothing attached.
+  EXPECT_FALSE(gnss.OnGnss(Fix(10.0, Vec3(101.0, 0.0, 0.0)), context_));
+  EXPECT_EQ(Residuals(), 1);
+  // The same 1 m with a window that is itself uncertain to 2 m (after an outage): accepted. A check with R
+  // alone would have rejected it.
+  sigma_p_ = 2.0;
+  EXPECT_TRUE(gnss.OnGnss(Fix(10.0, Vec3(101.0, 0.0, 0.0)), context_));
+  EXPECT_EQ(Residuals(), 2);
+  ASSERT_EQ(outcomes.size(), 3u);
+  EXPECT_TRUE(outcomes[0].second);
+  EXPECT_FALSE(outcomes[1].second);
+  EXPECT_TRUE(outcomes[2].second);
+  const nlohmann::json s = Stats(gnss);
+  EXPECT_EQ(s["gnss_position"]["used"], 2);
+  EXPECT_EQ(s["gnss_position"]["rejected"]["chi2_gate"], 1);
+}
+
+TEST_F(AttacherTest, AgreeingRejectedFixesReacquire) {
+  Push(0.0, 10.0);
+  sigma_p_ = 0.02;
+  std::vector<double> reacquired;
+  GnssAttacher gnss(options_, [](double, bool) {}, [&](double f) { reacquired.push_back(f); });
+  // The estimate is 0.5 m off (an overconfident window after an outage): every fix agrees with the next.
+  int accepted_at = -1;
+  for (int k = 0; k < 10 && accepted_at < 0; ++k) {
+    if (gnss.OnGnss(Fix(0.0 + k, Vec3(0.5, 0.0, 0.0) + store_.back().State().p_wb), context_)) accepted_at = k;
+  }
+  EXPECT_GT(accepted_at, 0);
+  EXPECT_LE(accepted_at, 6);  // 2^k doubt: (0.5/0.028)² ≈ 320 over a gate of 21 needs k ≈ 4
+  ASSERT_EQ(reacquired.size(), 1u);
+  EXPECT_GT(reacquired[0], 1.0);
+  EXPECT_EQ(Stats(gnss)["gnss_reacquired"], 1);
+}
+
+TEST_F(AttacherTest, ScatteredOutliersDoNotReacquire) {
+  Push(0.0, 10.0);
+  sigma_p_ = 0.02;
+  GnssAttacher gnss(options_, [](double, bool) {}, [](double) {});
+  // 20 m outliers in directions that change every time: never a run that agrees.
+  for (int k = 0; k < 12; ++k) {
+    const double a = 2.1 * k;
+    EXPECT_FALSE(gnss.OnGnss(Fix(k, store_.back().State().p_wb + 20.0 * Vec3(std::cos(a), std::sin(a), 0.0)),
+                             context_));
+  }
+  EXPECT_EQ(Stats(gnss)["gnss_reacquired"], 0);
+}
+
+TEST_F(AttacherTest, StandstillIsCheckedAgainstThePredictedVelocity) {
+  options_.standstill.max_speed = 0.5;
+  StandstillAttacher standstill(options_);
+  Keyframe& a = Push(20.0, 0.01);
+  standstill.OnStandstill({20.0, 18.0}, context_);
+  EXPECT_EQ(Residuals(), 1);  // the zero velocity
+  Keyframe& b = Push(20.5, 0.01);
+  standstill.OnKeyframeCreated(b, context_);
+  EXPECT_EQ(Residuals(), 1);  // the last detection (20.0) is too old for it
+  standstill.OnStandstill({20.5, 18.0}, context_);
+  EXPECT_EQ(Residuals(), 3);  // its zero velocity and the zero motion from a
+  EXPECT_TRUE(b.still_from_prev);
+  (void)a;
+  // A "standstill" the prediction contradicts (0.3 m/s with a velocity σ of 1 mm/s) is not taken.
+  Keyframe& c = Push(21.0, 0.3);
+  standstill.OnStandstill({21.0, 18.0}, context_);
+  EXPECT_EQ(Residuals(), 3);
+  (void)c;
+  const nlohmann::json s = Stats(standstill);
+  EXPECT_EQ(s["zero_velocity"]["used"], 2);
+  EXPECT_EQ(s["zero_velocity"]["rejected"]["chi2_gate"], 1);
+  EXPECT_EQ(s["zero_motion_factors"], 1);
+}
 
 WheelMeasurement Wheel(double t, double speed) {
   WheelMeasurement w;
@@ -55,164 +166,60 @@ WheelMeasurement Wheel(double t, double speed) {
   w.speed = speed;
   w.sigma = 0.05;
   w.interval = 0.1;
+  w.distance = speed * 0.1;
   return w;
 }
 
-TEST_F(AttacherTest, WheelGoesOnceToTheNewestKeyframeWithinTheReadingsInterval) {
-  options_.wheel.nonholonomic = true;
-  WheelAttacher wheel(options_);
-  Push(10.0, 3.0);
-  wheel.OnWheel(Wheel(10.05, 3.0), context_);  // interval (9.95, 10.05]: mid-time 10.0
-  EXPECT_EQ(Residuals(), 2);                   // speed and NHC
-  wheel.OnWheel(Wheel(10.06, 3.0), context_);
-  EXPECT_EQ(Residuals(), 2);  // once per keyframe
-  Keyframe& far = Push(10.5, 3.0);
-  wheel.OnKeyframeCreated(far, context_);  // the last reading is 0.49 s before it
-  EXPECT_EQ(Residuals(), 2);
-  wheel.OnWheel(Wheel(10.52, 3.0), context_);
-  EXPECT_EQ(Residuals(), 4);
-  EXPECT_EQ(Stats(wheel)["wheel"]["used"], 2);
+TEST_F(AttacherTest, OdometerIntegratesEveryRecordAndSplitsTheOneAcrossAKeyframe) {
+  VehicleAttacher vehicle(options_);
+  options_.vehicle.nonholonomic = false;
+  VehicleAttacher odometer_only(options_);
+  // Keyframes at 0, 1 and 2 s; records every 0.1 s from 0.05 s, so the record at 1.05 s straddles 1.0 s.
+  Keyframe& k0 = Push(0.0, 10.0);
+  odometer_only.OnKeyframeCreated(k0, context_);
+  for (double t = 0.05; t < 1.0; t += 0.1) odometer_only.OnWheel(Wheel(t, 10.0), context_);
+  Keyframe& k1 = Push(1.0, 10.0);
+  odometer_only.OnKeyframeCreated(k1, context_);
+  for (double t = 1.05; t < 2.0; t += 0.1) odometer_only.OnWheel(Wheel(t, 10.0), context_);
+  const int before = Residuals();
+  // The joint covariance of k0 and k1 after a "solve".
+  const int n = static_cast<int>(NavIndexOfTangent(store_.EstimatedTypes()).size());
+  two_ = MatX::Identity(2 * n, 2 * n) * 1e-4;
+  Keyframe& k2 = Push(2.0, 10.0);
+  odometer_only.OnKeyframeCreated(k2, context_);
+  // The interval [0, 1] is closed: 0.95 s of records from 0.05 s... its first record starts at −0.05 s
+  // (before k0), so 0.95 s is covered: enough. One odometer factor, at 10 m = 10·1 s... of which the
+  // records over (0, 1] give 10·(0.05 + 0.9 + 0.05) = 10 m.
+  EXPECT_EQ(Residuals(), before + 1);
+  const nlohmann::json s = Stats(odometer_only);
+  EXPECT_EQ(s["wheel"]["used"], 1);
+  EXPECT_GE(s["wheel"]["records"].get<int>(), 19);
+  (void)vehicle;
+}
 
+TEST_F(AttacherTest, NonHolonomicConstraintAtEachKeyframeWithOrWithoutWheels) {
   options_.wheel.enabled = false;
-  WheelAttacher off(options_);
-  off.OnKeyframeCreated(Push(11.0, 3.0), context_);
-  off.OnWheel(Wheel(11.0, 3.0), context_);
-  EXPECT_EQ(Residuals(), 4);
-}
-
-TEST_F(AttacherTest, WheelSpeedIsMovedToTheKeyframesTimeWithTheForwardAcceleration) {
-  WheelAttacher wheel(options_);
-  Push(10.0, 3.0);
-  // Accelerating forward at 2 m/s²: the mean over (9.95, 10.15], at its mid-time 10.05, was 0.1 m/s faster
-  // than the speed at 10.0.
-  ImuSample imu;
-  imu.t = 10.0;
-  imu.acc = Vec3(2.0, 0.0, 9.81);
-  last_imu_ = imu;
-  WheelMeasurement w = Wheel(10.15, 3.1);
-  w.interval = 0.2;
-  wheel.OnWheel(w, context_);
-  std::vector<ceres::ResidualBlockId> ids;
-  problem_.GetResidualBlocks(&ids);
-  ASSERT_EQ(ids.size(), 1u);
-  EXPECT_LT(SquaredResidual(ids[0]), 1e-20);
-  // Without the IMU the reading would be taken as the speed at the keyframe.
-  last_imu_.reset();
-  problem_.RemoveResidualBlock(ids[0]);
-  Push(10.5, 3.0);
-  wheel.OnWheel(Wheel(10.55, 3.2), context_);
-  problem_.GetResidualBlocks(&ids);
-  ASSERT_EQ(ids.size(), 1u);
-  EXPECT_NEAR(SquaredResidual(ids[0]), (0.2 / 0.05) * (0.2 / 0.05), 1e-9);
-}
-
-StandstillMeasurement Standstill(double since, double t) { return {t, since}; }
-
-TEST_F(AttacherTest, ZeroVelocityOnAStandingKeyframeNotOnAMovingOne) {
-  StandstillAttacher standstill(options_);
-  Push(10.0, 0.01);
-  standstill.OnStandstill(Standstill(9.0, 10.0), context_);
-  EXPECT_EQ(Residuals(), 1);
-  standstill.OnStandstill(Standstill(9.0, 10.1), context_);
-  EXPECT_EQ(Residuals(), 1);  // once per keyframe
-  Keyframe& late = Push(10.5, 0.01);
-  standstill.OnKeyframeCreated(late, context_);  // the last detection (10.1) is too old for 10.5
-  EXPECT_EQ(Residuals(), 1);
-  Push(11.0, 2.0);  // above standstill.max_speed_m_s
-  standstill.OnStandstill(Standstill(10.0, 11.0), context_);
-  EXPECT_EQ(Residuals(), 1);
-  EXPECT_EQ(Stats(standstill)["zero_velocity"]["rejected"]["moving"], 1);
-}
-
-TEST_F(AttacherTest, StandstillCheckJoinsConfirmedKeyframesAndDropsContradictedOnes) {
-  StandstillAttacher standstill(options_);
-  Keyframe& a = Push(10.0, 0.0);
-  standstill.OnStandstill(Standstill(9.0, 10.0), context_);
-  Keyframe& b = Push(10.5, 0.0);
-  standstill.OnStandstill(Standstill(9.0, 10.5), context_);
-  Keyframe& c = Push(11.0, 0.0);
-  standstill.OnStandstill(Standstill(9.0, 11.0), context_);
-  ASSERT_EQ(Residuals(), 3);
-  // The solve said c moves after all: its zero velocity goes; a and b stand, joined by a zero motion.
-  c.block(BlockType::kVelocity)[0] = 1.0;
-  EXPECT_TRUE(standstill.AfterSolve(context_));
-  EXPECT_EQ(Residuals(), 3);  // 3 zero velocities - 1 + 1 zero motion
-  EXPECT_FALSE(a.still_from_prev);
-  EXPECT_TRUE(b.still_from_prev);
-  EXPECT_FALSE(c.still_from_prev);
-  const nlohmann::json stats = Stats(standstill);
-  EXPECT_EQ(stats["zero_velocity"]["used"], 2);
-  EXPECT_EQ(stats["zero_velocity"]["rejected"]["chi2_gate"], 1);
-  EXPECT_EQ(stats["zero_motion_factors"], 1);
-  EXPECT_FALSE(standstill.AfterSolve(context_));  // each checked once
-  EXPECT_EQ(Residuals(), 3);
-}
-
-GnssMeasurement Fix(double t, const Vec3& p_w, bool heading) {
-  GnssMeasurement m;
-  m.t = t;
-  m.p_w = p_w;
-  m.sigma_w = Vec3(0.05, 0.05, 0.1);
-  m.heading_valid = heading;
-  m.yaw_G = 0.3;
-  m.sigma_yaw = 0.01;
-  return m;
-}
-
-TEST_F(AttacherTest, GnssAttachesPositionAndHeadingOncePerKeyframe) {
-  std::vector<std::pair<double, bool>> checked;
-  GnssAttacher gnss(options_, [&](double t, bool accepted) { checked.emplace_back(t, accepted); });
-  Keyframe& kf = Push(10.0, 3.0);
-  EXPECT_TRUE(gnss.OnGnss(Fix(10.0, kf.State().p_wb, true), context_));
-  EXPECT_EQ(Residuals(), 2);
-  EXPECT_FALSE(gnss.OnGnss(Fix(10.0, kf.State().p_wb, true), context_));  // one fix per epoch
-  EXPECT_EQ(Residuals(), 2);
-  Keyframe& next = Push(10.5, 3.0);
-  options_.gnss.use_heading = false;
-  GnssAttacher no_heading(options_, [](double, bool) {});
-  EXPECT_TRUE(no_heading.OnGnss(Fix(10.5, next.State().p_wb, true), context_));
-  EXPECT_EQ(Residuals(), 3);
-  EXPECT_EQ(Stats(gnss)["gnss_heading"]["used"], 1);
-  EXPECT_TRUE(checked.empty());
-}
-
-TEST_F(AttacherTest, GnssCheckKeepsAGoodFixAndRemovesAnOutlier) {
-  std::vector<std::pair<double, bool>> checked;
-  GnssAttacher gnss(options_, [&](double t, bool accepted) { checked.emplace_back(t, accepted); });
-  Keyframe& good = Push(10.0, 3.0);
-  gnss.OnGnss(Fix(10.0, good.State().p_wb + Vec3(0.02, -0.03, 0.05), false), context_);
-  EXPECT_FALSE(gnss.AfterSolve(context_));
-  EXPECT_EQ(Residuals(), 1);
-  Keyframe& bad = Push(10.5, 3.0);
-  gnss.OnGnss(Fix(10.5, bad.State().p_wb + Vec3(3.0, 0.0, 0.0), false), context_);
-  EXPECT_EQ(Residuals(), 2);
-  EXPECT_TRUE(gnss.AfterSolve(context_));  // removed: solve again
-  EXPECT_EQ(Residuals(), 1);
-  EXPECT_FALSE(gnss.AfterSolve(context_));  // checked once
-  EXPECT_EQ(checked, (std::vector<std::pair<double, bool>>{{10.0, true}, {10.5, false}}));
-  const nlohmann::json stats = Stats(gnss);
-  EXPECT_EQ(stats["gnss_position"]["used"], 1);
-  EXPECT_EQ(stats["gnss_position"]["rejected"]["chi2_gate"], 1);
-}
-
-// A new measurement type is a new attacher: the interface's defaults leave everything else alone.
-class CountingAttacher final : public MeasurementAttacher {
- public:
-  void OnKeyframeCreated(Keyframe& /*kf*/, const AttachContext& /*ctx*/) override { ++created; }
-  int created = 0;
-};
-
-TEST_F(AttacherTest, InterfaceDefaultsDoNothing) {
-  CountingAttacher a;
-  Keyframe& kf = Push(10.0, 3.0);
-  EXPECT_FALSE(a.OnGnss(Fix(10.0, Vec3::Zero(), true), context_));
-  a.OnWheel(Wheel(10.0, 1.0), context_);
-  a.OnStandstill(Standstill(9.0, 10.0), context_);
-  a.OnKeyframeCreated(kf, context_);
-  EXPECT_FALSE(a.AfterSolve(context_));
-  EXPECT_EQ(a.created, 1);
-  EXPECT_EQ(Residuals(), 0);
-  EXPECT_TRUE(Stats(a).is_null());
+  VehicleAttacher vehicle(options_);
+  Keyframe& k0 = Push(0.0, 10.0);
+  vehicle.OnKeyframeCreated(k0, context_);
+  EXPECT_EQ(Residuals(), 1);  // the NHC at k0
+  const int n = static_cast<int>(NavIndexOfTangent(store_.EstimatedTypes()).size());
+  two_ = MatX::Identity(2 * n, 2 * n) * 1e-4;
+  Keyframe& k1 = Push(1.0, 10.0);
+  auto preint = std::make_shared<Preintegration>(Vec3::Zero(), Vec3::Zero(), 1e-3, 1e-2);
+  preint->Integrate(Vec3::Zero(), Vec3(0.0, 0.0, 9.81), 1.0);
+  k1.preint = preint;
+  vehicle.OnKeyframeCreated(k1, context_);
+  EXPECT_EQ(Residuals(), 3);  // the chord from k0 and the NHC at k1
+  // A keyframe sliding sideways at 2 m/s is rejected by its check (σ 0.1 m/s).
+  NavState x = k1.State();
+  x.t = 2.0;
+  x.v_w = Vec3(10.0, 2.0, 0.0);
+  Keyframe& k2 = store_.Push(store_.Make(2.0, x));
+  vehicle.OnKeyframeCreated(k2, context_);
+  const nlohmann::json s = Stats(vehicle);
+  EXPECT_EQ(s["nonholonomic"]["used"], 2);
+  EXPECT_EQ(s["nonholonomic"]["rejected"]["chi2_gate"], 1);
 }
 
 }  // namespace

@@ -490,9 +490,9 @@ TEST(SimConfig, NewKeysLoadValidateAndEcho) {
   const Options back = LoadOptionsFromString(echo, "echo.yaml");
   EXPECT_EQ(OptionsToYaml(back), echo);
 
-  // Defaults: the flat, white, whole-drive simulator without GNSS velocity.
+  // Defaults: the rotating Earth, white noise, the whole drive, no GNSS velocity.
   const SimOptions d = LoadOptionsFromString("simulate: {}\n", "test.yaml").simulate;
-  EXPECT_FALSE(d.earth_rotation);
+  EXPECT_TRUE(d.earth_rotation);
   EXPECT_TRUE(d.gnss_velocity_sigma.isZero());
   EXPECT_EQ(d.gnss_noise_correlation, 0.0);
   EXPECT_EQ(d.log_start, 0.0);

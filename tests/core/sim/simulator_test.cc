@@ -23,8 +23,11 @@ namespace {
 
 // 60 s: standstill, accelerate, climbing left turn, level right turn, descending left turn while braking,
 // accelerate, brake hard enough to stop (the speed clamp engages for the last ~3 s).
+// The flat Earth: these tests check its exact truth against the flat kernel and geodesy (the rotating Earth
+// has its own in simulator_earth_test.cc).
 SimOptions Drive() {
   SimOptions sim;
+  sim.earth_rotation = false;
   sim.seed = 7;
   sim.initial_yaw = 0.3;
   sim.segments = {{2.0, 0.0, 0.0, 0.0},          {6.0, 1.5, 0.0, 0.0},

@@ -1,0 +1,99 @@
+#include "factors/preint_attached_factor.h"
+
+#include <ceres/jet.h>
+
+#include "core/so3.h"
+
+namespace gins {
+namespace {
+
+using Mat9x15 = Eigen::Matrix<double, 9, 15>;
+// Rows (δp_t, δθ_t, δv_t), columns (δp_i, δθ_i, δv_i, δbg, δba).
+constexpr int kRowP = 0, kRowTheta = 3, kRowV = 6;
+constexpr int kColP = 0, kColTheta = 3, kColV = 6, kColBg = 9, kColBa = 12;
+
+// The prediction's Jacobian (see PreintAttachedCostFunction in the header).
+Mat9x15 PredictionJacobian(const Preintegration& pre, const ImuEarthTerms& earth, const EarthTurns& turns,
+                           const Quat& q_i, const Vec3& bg, const Vec3& ba) {
+  const Preintegration::Delta d = pre.Corrected(bg, ba);
+  const Mat96& Jb = pre.bias_jacobian();
+  const Mat3 R_i = q_i.toRotationMatrix();
+  const double T = pre.dt();
+  const Mat3 A = turns.m_inv;  // identity for the flat Earth
+  const Mat3 Rp = turns.back_p.toRotationMatrix() * R_i;
+  const Mat3 Rv = turns.back_v.toRotationMatrix() * R_i;
+  Mat9x15 J = Mat9x15::Zero();
+  // δp_t − δp_i first (the Coriolis term of δv_t needs it), then δp_t adds δp_i.
+  Eigen::Matrix<double, 3, 15> dP = Eigen::Matrix<double, 3, 15>::Zero();
+  dP.block<3, 3>(0, kColV) = A * T;
+  dP.block<3, 3>(0, kColTheta) = -A * Rp * Hat<double>(d.dp);
+  dP.block<3, 6>(0, kColBg) = A * Rp * Jb.middleRows<3>(preint::kP);
+  J.middleRows<3>(kRowP) = dP;
+  J.block<3, 3>(kRowP, kColP).setIdentity();
+  J.block<3, 3>(kRowTheta, kColTheta) = d.dq.toRotationMatrix().transpose();
+  const Vec3 phi = Jb.block<3, 3>(preint::kTheta, preint::kBg) * (bg - pre.bg_lin());
+  J.block<3, 3>(kRowTheta, kColBg) = RightJacobian(phi) * Jb.block<3, 3>(preint::kTheta, preint::kBg);
+  J.block<3, 3>(kRowV, kColV).setIdentity();
+  J.block<3, 3>(kRowV, kColTheta) = -Rv * Hat<double>(d.dv);
+  J.block<3, 6>(kRowV, kColBg) = Rv * Jb.middleRows<3>(preint::kV);
+  if (turns.rotating) J.middleRows<3>(kRowV) -= 2.0 * Hat<double>(earth.rate_w) * dP;
+  return J;
+}
+
+}  // namespace
+
+template <class Measurement>
+bool PreintAttachedCostFunction<Measurement>::Evaluate(double const* const* parameters, double* residuals,
+                                                       double** jacobians) const {
+  constexpr int M = Measurement::kResidualDim;
+  const double* pose_i = parameters[0];
+  const Eigen::Map<const Vec3> p_i(pose_i + pose::kP), v_i(parameters[1]);
+  const Eigen::Map<const Quat> q_i(pose_i + pose::kQ);
+  const Eigen::Map<const Vec3> bg(parameters[2]), ba(parameters[2] + 3);
+  const Preintegration& pre = factor_.preintegration();
+  const PredictedKinematics<double> k = PredictKinematics<double>(
+      pre, factor_.earth(), factor_.turns(), Vec3(p_i), Quat(q_i), Vec3(v_i), Vec3(bg), Vec3(ba));
+  // The measurement at the predicted state, differentiated in (δp_t, δθ_t, δv_t) with Jets.
+  using Jet = ceres::Jet<double, 9>;
+  PredictedKinematics<Jet> kj;
+  Eigen::Matrix<Jet, 3, 1> dtheta;
+  for (int c = 0; c < 3; ++c) {
+    kj.p[c] = Jet(k.p[c], kRowP + c);
+    dtheta[c] = Jet(0.0, kRowTheta + c);
+    kj.v[c] = Jet(k.v[c], kRowV + c);
+  }
+  kj.q = k.q.cast<Jet>() * ExpQuat<Jet>(dtheta);
+  Jet r[M];
+  factor_.measurement()(kj, r);
+  Eigen::Matrix<double, M, 9> J_meas;
+  for (int i = 0; i < M; ++i) {
+    residuals[i] = r[i].a;
+    J_meas.row(i) = r[i].v.transpose();
+  }
+  if (jacobians == nullptr) return true;
+  const Eigen::Matrix<double, M, 15> J =
+      J_meas * PredictionJacobian(pre, factor_.earth(), factor_.turns(), Quat(q_i), Vec3(bg), Vec3(ba));
+  if (jacobians[0] != nullptr) {  // pose_i: tangent (δp, δθ) lifted by M(q) = 2·[w·I − [v]×, −v]
+    Eigen::Matrix<double, 3, 4> Mq;
+    Mq.leftCols<3>() = 2.0 * (q_i.w() * Mat3::Identity() - Hat<double>(q_i.vec()));
+    Mq.col(3) = -2.0 * q_i.vec();
+    Eigen::Map<Eigen::Matrix<double, M, pose::kAmbient, Eigen::RowMajor>> out(jacobians[0]);
+    out.template middleCols<3>(pose::kP) = J.template middleCols<3>(kColP);
+    out.template middleCols<4>(pose::kQ) = J.template middleCols<3>(kColTheta) * Mq;
+  }
+  if (jacobians[1] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, M, 3, Eigen::RowMajor>> out(jacobians[1]);
+    out = J.template middleCols<3>(kColV);
+  }
+  if (jacobians[2] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, M, 6, Eigen::RowMajor>> out(jacobians[2]);
+    out = J.template middleCols<6>(kColBg);
+  }
+  return true;
+}
+
+template class PreintAttachedCostFunction<GnssAtTime>;
+template class PreintAttachedCostFunction<HeadingAtTime>;
+template class PreintAttachedCostFunction<GvelAtTime>;
+
+}  // namespace gins

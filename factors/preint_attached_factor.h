@@ -1,0 +1,123 @@
+// A measurement at its own time t, between keyframe i and the next, attached to keyframe i through the IMU
+// preintegrated from t_i to t: the state at t is PredictKinematics(Δ_i→t, state i) (core/preintegration.h:
+// bias-corrected to first order, Earth terms included), and the measurement's model takes it from there.
+// So keyframe placement never costs a measurement (a 10 Hz receiver with keyframes every 0.5-1 s).
+//
+// Parameter blocks: pose_i (7: p_wb, q_wb x y z w — factors/pose_manifold.h), vel_i (3), bias_i (6).
+// Residual: the model's, whitened by it. Models (each delegates to its core model):
+//   GnssAtTime     r = (p_t + R_t·lever_b − z_w) ./ σ_w                     (3, core/gnss_model.h)
+//   HeadingAtTime  r = wrap(yaw(R_t·Rz(mount)) − yaw_meas) / σ              (1, core/heading_model.h)
+//   GvelAtTime     r = (v_t + R_t·(ω_b × lever_b) − z_w) ./ σ_w             (3, core/gvel_model.h)
+#pragma once
+
+#include <ceres/cost_function.h>
+#include <ceres/sized_cost_function.h>
+
+#include <memory>
+#include <utility>
+
+#include "core/conventions.h"
+#include "core/gnss_model.h"
+#include "core/gvel_model.h"
+#include "core/heading_model.h"
+#include "core/preintegration.h"
+#include "factors/pose_manifold.h"
+
+namespace gins {
+
+struct GnssAtTime {
+  static constexpr int kResidualDim = GnssPositionModel::kResidualDim;
+  Vec3 z_w, inv_sigma, lever_b;
+  template <typename T>
+  void operator()(const PredictedKinematics<T>& k, T* residual) const {
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> out(residual);
+    out = GnssPositionModel::Residual<T>(k.p, k.q, lever_b, z_w).cwiseProduct(inv_sigma.cast<T>());
+  }
+};
+
+struct HeadingAtTime {
+  static constexpr int kResidualDim = HeadingModel::kResidualDim;
+  double yaw_meas, inv_sigma, mount_yaw;
+  template <typename T>
+  void operator()(const PredictedKinematics<T>& k, T* residual) const {
+    residual[0] = HeadingModel::Residual<T>(k.q, mount_yaw, yaw_meas) * T(inv_sigma);
+  }
+};
+
+struct GvelAtTime {
+  static constexpr int kResidualDim = GnssVelocityModel::kResidualDim;
+  Vec3 z_w, inv_sigma, omega_b, lever_b;
+  template <typename T>
+  void operator()(const PredictedKinematics<T>& k, T* residual) const {
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> out(residual);
+    out = GnssVelocityModel::Residual<T>(k.q, k.v, omega_b, lever_b, z_w).cwiseProduct(inv_sigma.cast<T>());
+  }
+};
+
+template <class Measurement>
+class PreintAttachedFactor {
+ public:
+  static constexpr int kResidualDim = Measurement::kResidualDim;
+
+  PreintAttachedFactor(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth,
+                       Measurement measurement)
+      : preint_(std::move(preint)),
+        earth_(earth),
+        turns_(earth, preint_->dt()),
+        measurement_(std::move(measurement)) {}
+
+  template <typename T>
+  bool operator()(const T* pose_i, const T* vel_i, const T* bias_i, T* residual) const {
+    using Vec3T = Eigen::Matrix<T, 3, 1>;
+    const PredictedKinematics<T> k = PredictKinematics<T>(
+        *preint_, earth_, turns_, Vec3T(PosePosition(pose_i)), Eigen::Quaternion<T>(PoseRotation(pose_i)),
+        Eigen::Map<const Vec3T>(vel_i), Eigen::Map<const Vec3T>(bias_i), Eigen::Map<const Vec3T>(bias_i + 3));
+    measurement_(k, residual);
+    return true;
+  }
+
+  // The production cost function: PreintAttachedCostFunction (analytic prediction Jacobians). Requires a
+  // non-empty preintegration and σ > 0 (the measurement's inverse σ finite).
+  static ceres::CostFunction* Create(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth,
+                                     Measurement measurement);
+  // AutoDiffCostFunction<PreintAttachedFactor, kResidualDim, 7, 3, 6> of the same residual: the test oracle.
+  static ceres::CostFunction* CreateAutoDiff(std::shared_ptr<const Preintegration> preint,
+                                             const ImuEarthTerms& earth, Measurement measurement);
+
+  const Preintegration& preintegration() const { return *preint_; }
+  const ImuEarthTerms& earth() const { return earth_; }
+  const EarthTurns& turns() const { return turns_; }
+  const Measurement& measurement() const { return measurement_; }
+
+ private:
+  std::shared_ptr<const Preintegration> preint_;
+  ImuEarthTerms earth_;
+  EarthTurns turns_;
+  Measurement measurement_;
+};
+
+// PreintAttachedFactor with analytic Jacobians of the prediction: the state at t as a function of state i and
+// its biases (core/preintegration.h: PredictKinematics), 9×15 in closed form in the right-perturbed tangents,
+//   δp_t = δp_i + A·T·δv_i − A·E3ᵀ·R_i·[Δp]×·δθ_i + A·E3ᵀ·R_i·(∂Δp/∂b)·δb
+//   δθ_t = ΔRᵀ·δθ_i + Jr(φ)·(∂ΔR/∂bg)·δbg
+//   δv_t = δv_i − E2ᵀ·R_i·[Δv]×·δθ_i + E2ᵀ·R_i·(∂Δv/∂b)·δb − 2[ω]×·(δp_t − δp_i)
+// (A = (I + [ω]×T)⁻¹, E_k the Earth's turns; identities for the flat Earth), times the measurement's own
+// Jacobian in (δp_t, δθ_t, δv_t) from autodiff with 9-dimensional Jets (cheap: the model is a few lines).
+// The pose block's tangent Jacobian is lifted to the ambient one as ImuCostFunction does.
+template <class Measurement>
+class PreintAttachedCostFunction final
+    : public ceres::SizedCostFunction<Measurement::kResidualDim, pose::kAmbient, 3, 6> {
+ public:
+  PreintAttachedCostFunction(std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth,
+                             Measurement measurement)
+      : factor_(std::move(preint), earth, std::move(measurement)) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+  const PreintAttachedFactor<Measurement>& factor() const { return factor_; }
+
+ private:
+  PreintAttachedFactor<Measurement> factor_;
+};
+
+}  // namespace gins

@@ -1,0 +1,219 @@
+// The ESKF's measurement updates: each linearises its model from core/*_model.h at the current nominal
+// state (with Jets, core/linearize.h), in the blocks it touches, and hands it to Eskf::Update.
+#include <cmath>
+
+#include "core/gnss_model.h"
+#include "core/gvel_model.h"
+#include "core/heading_model.h"
+#include "core/linearize.h"
+#include "core/so3.h"
+#include "core/wheel_model.h"
+#include "solver/eskf.h"
+
+namespace gins {
+
+using eskf::Block;
+using eskf::BlockOf;
+using eskf::EmbedJacobian;
+
+namespace {
+
+// The state the models see: the nominal state perturbed by the first N coordinates of a Jet vector, taken
+// as (δp, δθ), (δv, δθ) or (δv, δθ, δs) as each model needs.
+template <typename T>
+Eigen::Quaternion<T> Rotated(const NavState& x, const Eigen::Matrix<T, 3, 1>& d_theta) {
+  return x.q_wb.cast<T>() * ExpQuat<T>(d_theta);
+}
+
+}  // namespace
+
+void Eskf::AddGnss(const GnssMeasurement& m) {
+  if (!initialized_ || m.t < x_.t) return;
+  Propagate(m.t);
+  if (options_.watchdog.enabled) {
+    const double max_sigma = options_.watchdog.max_position_sigma;
+    const bool finite = x_.AllFinite() && P_.allFinite() && dg_w_.allFinite() && std::isfinite(scale_);
+    if (!finite || BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
+      ResetFromGnss(m, finite ? "covariance" : "non_finite");
+      prev_fix_ = m;
+      return;
+    }
+  }
+  const bool accepted = UpdateGnssPosition(m);
+  const bool reset = WatchGnss(m, accepted);
+  prev_fix_ = m;
+  if (reset) return;
+  if (m.heading_valid && options_.gnss.use_heading) UpdateHeading(m);
+}
+
+bool Eskf::UpdateGnssPosition(const GnssMeasurement& m) {
+  const Model<3> model = [&] {
+    Eigen::Matrix<double, 3, 1> r;
+    Eigen::Matrix<double, 3, 6> H6;  // (δp, δθ)
+    Linearize<3, 6>(
+        [&](const auto& d) {
+          using T = typename std::decay_t<decltype(d)>::Scalar;
+          const Eigen::Matrix<T, 3, 1> p = x_.p_wb.cast<T>() + d.template head<3>();
+          return GnssPositionModel::Residual<T>(p, Rotated<T>(x_, d.template tail<3>()), options_.gnss.lever_b,
+                                                m.p_w);
+        },
+        &r, &H6);
+    return Linearized<3>{r, EmbedJacobian<3>({{Block::kP, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}})};
+  };
+  const Mat3 R = m.sigma_w.cwiseAbs2().asDiagonal();
+  const double inflation = gnss_inflation_.factor();
+  Vec3 innovation;
+  Mat3 S;
+  const bool accepted = Update<3>(model, R, gate_gnss_, &gnss_counts_, m.t, inflation, &innovation, &S);
+  if (accepted) {
+    if (inflation > 1.0) gnss_inflation_.CountReacquired();
+    gnss_inflation_.Accepted();
+  } else {
+    gnss_inflation_.Rejected(m.t, innovation, S, gate_gnss_);
+  }
+  return accepted;
+}
+
+void Eskf::UpdateHeading(const GnssMeasurement& m) {
+  const Model<1> model = [&] {
+    Eigen::Matrix<double, 1, 1> r;
+    Eigen::Matrix<double, 1, 3> H3;
+    Linearize<1, 3>(
+        [&](const auto& d) {
+          using T = typename std::decay_t<decltype(d)>::Scalar;
+          return Eigen::Matrix<T, 1, 1>(
+              HeadingModel::Residual<T>(Rotated<T>(x_, Eigen::Matrix<T, 3, 1>(d)), options_.gnss.mount_yaw, m.yaw_G));
+        },
+        &r, &H3);
+    return Linearized<1>{r, EmbedJacobian<1>({{Block::kTheta, H3}})};
+  };
+  Update<1>(model, Eigen::Matrix<double, 1, 1>(m.sigma_yaw * m.sigma_yaw), gate_heading_, &heading_counts_, m.t);
+}
+
+void Eskf::AddGvel(const GvelMeasurement& m) {
+  if (!initialized_ || m.t < x_.t) return;
+  Propagate(m.t);
+  // The antenna's velocity includes the lever arm's turn: the body rate from the last IMU sample.
+  const Vec3 omega_b = BodyRate();
+  const Model<3> model = [&] {
+    Eigen::Matrix<double, 3, 1> r;
+    Eigen::Matrix<double, 3, 6> H6;  // (δv, δθ)
+    Linearize<3, 6>(
+        [&](const auto& d) {
+          using T = typename std::decay_t<decltype(d)>::Scalar;
+          const Eigen::Matrix<T, 3, 1> v = x_.v_w.cast<T>() + d.template head<3>();
+          return GnssVelocityModel::Residual<T>(Rotated<T>(x_, d.template tail<3>()), v, omega_b,
+                                                options_.gnss.lever_b, m.v_w);
+        },
+        &r, &H6);
+    return Linearized<3>{r, EmbedJacobian<3>({{Block::kV, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}})};
+  };
+  Update<3>(model, Mat3(m.sigma_w.cwiseAbs2().asDiagonal()), gate_gnss_, &gvel_counts_, m.t);
+}
+
+void Eskf::AddWheel(const WheelMeasurement& m) {
+  if (!initialized_ || m.t < x_.t || !options_.wheel.enabled) return;
+  Propagate(m.t);
+  // At zero pulses this is a zero-speed measurement; the standstill updates (AddStandstill) come from the
+  // session's detector, which also wants the IMU quiet.
+  UpdateWheelSpeed(m);
+  if (m.has_yaw_rate) UpdateWheelYawRate(m);
+  wheel_gyro_sum_.setZero();
+  wheel_gyro_count_ = 0;
+}
+
+void Eskf::UpdateWheelSpeed(const WheelMeasurement& m) {
+  // The encoders report the mean speed over their interval: compare with the velocity at its middle (at
+  // 1 m/s² and 0.1 s this is a 5 cm/s difference), at the rear-axle centre.
+  const Vec3 omega_b = BodyRate();
+  const Model<1> model = [&] {
+    Eigen::Matrix<double, 1, 1> r;
+    Eigen::Matrix<double, 1, 7> H7;  // (δv, δθ, δs)
+    const Vec3 v_mid = x_.v_w - a_w_ * (0.5 * m.interval);
+    const double s0 = scale_;
+    Linearize<1, 7>(
+        [&](const auto& d) {
+          using T = typename std::decay_t<decltype(d)>::Scalar;
+          const Eigen::Matrix<T, 3, 1> v = v_mid.cast<T>() + d.template head<3>();
+          const T s = T(s0) + d[6];
+          return Eigen::Matrix<T, 1, 1>(AxleSpeedModel::Residual<T>(
+              Rotated<T>(x_, Eigen::Matrix<T, 3, 1>(d.template segment<3>(3))), v, s, omega_b,
+              options_.wheel.lever_b, m.speed));
+        },
+        &r, &H7);
+    if (!options_.wheel.estimate_scale) H7(0, 6) = 0.0;  // a scale held fixed takes no correction
+    return Linearized<1>{r, EmbedJacobian<1>({{Block::kV, H7.leftCols<3>()},
+                                              {Block::kTheta, H7.middleCols<3>(3)},
+                                              {Block::kS, H7.rightCols<1>()}})};
+  };
+  Update<1>(model, Eigen::Matrix<double, 1, 1>(m.sigma * m.sigma), gate_wheel_, &wheel_counts_, m.t);
+}
+
+void Eskf::UpdateWheelYawRate(const WheelMeasurement& m) {
+  if (wheel_gyro_count_ == 0 || m.interval <= 0.0) return;
+  // The wheels' turn rate (read with the odometer scale, as their speeds are) against the gyro's mean
+  // over the same interval: it observes the gyro's z bias (and the scale, weakly).
+  const Vec3 mean_gyro = wheel_gyro_sum_ / wheel_gyro_count_;
+  const Model<1> model = [&] {
+    const double omega_z = (mean_gyro - x_.bg - x_.q_wb.conjugate() * earth_.rate_w()).z();
+    Eigen::Matrix<double, 1, eskf::kDim> H = Eigen::Matrix<double, 1, eskf::kDim>::Zero();
+    H(0, eskf::Offset(Block::kBg) + 2) = -scale_;
+    if (options_.wheel.estimate_scale) H(0, eskf::kS) = omega_z;
+    return Linearized<1>{Eigen::Matrix<double, 1, 1>(scale_ * omega_z - m.yaw_rate), H};
+  };
+  // The gyro's own noise over the interval adds to the wheels'.
+  const double gyro_var = std::pow(options_.imu.gyro_noise_density, 2) / m.interval;
+  const double var = m.yaw_rate_sigma * m.yaw_rate_sigma + scale_ * scale_ * gyro_var;
+  Update<1>(model, Eigen::Matrix<double, 1, 1>(var), gate_wheel_yaw_, &wheel_yaw_counts_, m.t);
+}
+
+void Eskf::UpdateNonHolonomic(double t) {
+  const Vec3 omega_b = BodyRate();
+  const Model<2> model = [&] {
+    Eigen::Matrix<double, 2, 1> r;
+    Eigen::Matrix<double, 2, 6> H6;  // (δv, δθ)
+    Linearize<2, 6>(
+        [&](const auto& d) {
+          using T = typename std::decay_t<decltype(d)>::Scalar;
+          const Eigen::Matrix<T, 3, 1> v = x_.v_w.cast<T>() + d.template head<3>();
+          return AxleNhcModel::Residual<T>(Rotated<T>(x_, Eigen::Matrix<T, 3, 1>(d.template tail<3>())), v, omega_b,
+                                           options_.wheel.lever_b);
+        },
+        &r, &H6);
+    return Linearized<2>{r, EmbedJacobian<2>({{Block::kV, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}})};
+  };
+  const double s2 = options_.vehicle.nhc_sigma * options_.vehicle.nhc_sigma;
+  Update<2>(model, Eigen::Matrix2d::Identity() * s2, gate_nhc_, &nhc_counts_, t);
+}
+
+void Eskf::AddStandstill(const StandstillMeasurement& m) {
+  if (!initialized_ || m.t < x_.t) return;
+  Propagate(m.t);
+  // The gyro mean since the last update observes the bias only if the whole interval was standing.
+  const bool rate_usable = gyro_count_ > 0 && gyro_sum_start_ >= m.since && m.t > gyro_sum_start_;
+  const Vec3 mean_gyro = gyro_count_ > 0 ? Vec3(gyro_sum_ / gyro_count_) : Vec3::Zero();
+  const double T = m.t - gyro_sum_start_;
+  gyro_sum_.setZero();
+  gyro_count_ = 0;
+  gyro_sum_start_ = m.t;
+  if (!StandstillPlausible(x_.v_w, options_.standstill)) {
+    zupt_counts_.Reject("moving", m.t);  // a quiet IMU at speed: not a stop
+    return;
+  }
+  // Standing: zero velocity, and the gyro reads its bias (zero-rate update), so nothing wanders.
+  const double sv = options_.standstill.velocity_sigma;
+  Update<3>([&] { return Linearized<3>{x_.v_w, EmbedJacobian<3>({{Block::kV, Mat3::Identity()}})}; },
+            Mat3::Identity() * sv * sv, gate_zupt_, &zupt_counts_, m.t);
+  if (rate_usable) {
+    // Standing on the rotating Earth, the gyro reads its bias plus the Earth rate.
+    const double sigma = 2.0 * options_.imu.gyro_noise_density / std::sqrt(T);
+    Update<3>(
+        [&] {
+          return Linearized<3>{Vec3(x_.bg + x_.q_wb.conjugate() * earth_.rate_w() - mean_gyro),
+                               EmbedJacobian<3>({{Block::kBg, Mat3::Identity()}})};
+        },
+        Mat3::Identity() * sigma * sigma, gate_zero_rate_, &zupt_counts_, m.t);
+  }
+}
+
+}  // namespace gins

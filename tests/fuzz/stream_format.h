@@ -5,7 +5,7 @@
 //
 // Header, 4 bytes:
 //   h0 bits: 0 wheel.enabled, 1 gnss.use_heading, 2 init.wait_for_heading, 3 gnss.use_velocity,
-//            4 standstill.enabled, 5 wheel.nonholonomic, 6 eskf.estimate_gravity, 7 watchdog.enabled
+//            4 standstill.enabled, 5 vehicle.nonholonomic, 6 eskf.estimate_gravity, 7 watchdog.enabled
 //   h1 bits: 0-1 smoother.window_size − 2, 2-3 smoother.max_iterations − 1, 4 dense_schur, 5 init.static_
 //            duration_s 0.5 (else 2), 6 gnss.origin at the base point (else the first fix), 7 edge options
 //            (min_keyframe_interval 0, max_keyframe_interval 0.2 s, imu.max_gap 0.05 s, watchdog 2 s / 5 m)
@@ -178,7 +178,7 @@ inline void StreamDecoder::DecodeHeader() {
   o.init.wait_for_heading = h0 & 4;
   o.gnss.use_velocity = h0 & 8;
   o.standstill.enabled = h0 & 16;
-  o.wheel.nonholonomic = h0 & 32;
+  o.vehicle.nonholonomic = h0 & 32;
   o.eskf.estimate_gravity = h0 & 64;
   o.watchdog.enabled = h0 & 128;
   o.smoother.window_size = 2 + (h1 & 3);

@@ -95,6 +95,9 @@ class Preintegration {
   // factor's square-root information would pin them to 1e-12 of the largest variance, so tightly that the
   // smoother's solve stalled on them (every fix of a dropout rejected) and its covariance recovery failed.
   void IntegrateGuess(const Vec3& gyro, const Vec3& acc, double dt, double held_gyro_sigma, double held_acc_sigma);
+  // The same with the rate's σ per body axis (a vehicle's unknown turn is mostly about its vertical).
+  void IntegrateGuess(const Vec3& gyro, const Vec3& acc, double dt, const Vec3& held_gyro_sigma,
+                      double held_acc_sigma);
 
   // Re-runs the stored samples with a new linearisation point (exact, not first order). Noise densities
   // are kept.
@@ -137,7 +140,7 @@ class Preintegration {
     Vec3 gyro;
     Vec3 acc;
     double dt;
-    double held_gyro_sigma = 0.0;  // IntegrateGuess
+    Vec3 held_gyro_sigma = Vec3::Zero();  // IntegrateGuess
     double held_acc_sigma = 0.0;
   };
   void Reset();

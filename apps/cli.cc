@@ -9,10 +9,12 @@
 
 #include "apps/convert_command.h"
 #include "apps/eval_command.h"
+#include "apps/report_command.h"
+#include "apps/run_command.h"
+#include "apps/stream_command.h"
 #include "config/config_loader.h"
 #include "core/io/log_reader.h"
 #include "core/sim/simulator.h"
-#include "solver/runner.h"
 
 namespace gins {
 namespace {
@@ -110,6 +112,10 @@ int RunCli(int argc, const char* const* argv) {
   auto* eval = AddEvalCommand(app, &eval_req);
   ConvertRequest convert_req;  // gins convert (apps/convert_command.h)
   auto* convert = AddConvertCommand(app, &convert_req);
+  StreamRequest stream_req;  // gins stream (apps/stream_command.h)
+  auto* stream = AddStreamCommand(app, &stream_req);
+  ReportRequest report_req;  // gins report (apps/report_command.h)
+  auto* report = AddReportCommand(app, &report_req);
 
   try {
     app.parse(argc, argv);
@@ -119,14 +125,22 @@ int RunCli(int argc, const char* const* argv) {
     return code == 0 ? 0 : 2;
   }
 
+  if (*stream) {
+    if (stream_req.online && stream_req.mode != "smoother") {
+      std::fprintf(stderr, "gins stream: --online needs --mode smoother\n");
+      return 2;
+    }
+    return RunStream(stream_req, 0, stdout);
+  }
+  if (*report) return RunReport(report_req);
   if (*eval) return RunEval(eval_req);
   if (*convert) return RunConvert(convert_req);
   try {
     if (*run) {
-      const Options options = LoadOptions(config_path);
+      const api::Config config = api::Config::FromFile(config_path);
       req.config_path = config_path;
       if (!truth_path.empty()) req.truth_path = truth_path;
-      const RunResult result = Run(options, req);
+      const RunResult result = Run(config, req);
       PrintRunReport(req, result);
       return 0;
     }

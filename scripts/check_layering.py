@@ -11,7 +11,8 @@ import os
 import re
 import sys
 
-# Library -> its folder and the libraries it may include (besides itself).
+# Library -> its folder and the libraries it may include (besides itself). "public" is the API's installed
+# header, gins/gins.h: it may include no gins header at all, so its users need none of the internals.
 LAYERS = {
     "core": ("core", []),
     "io": ("core/io", ["core"]),
@@ -20,14 +21,21 @@ LAYERS = {
     "factors": ("factors", ["core"]),
     "solver": ("solver", ["core", "io", "eval", "factors"]),
     "config": ("config", ["core", "io", "eval", "sim", "factors", "solver"]),
-    "apps": ("apps", ["core", "io", "eval", "sim", "factors", "solver", "config"]),
+    "public": ("apps/include/gins", []),
+    "api": ("apps/api", ["core", "io", "eval", "sim", "factors", "solver", "config", "public"]),
+    "apps": ("apps", ["core", "io", "eval", "sim", "factors", "solver", "config", "public", "api"]),
 }
+# Include paths that are not the folder under the source root: the public header is included as
+# "gins/gins.h" (its include directory is apps/include, as once installed).
+INCLUDE_FOLDERS = {"gins": "apps/include/gins"}
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
+SYSTEM_INCLUDE = re.compile(r'^\s*#\s*include\s+<([^>]+)>')
 
 
 def library_of(path):
-    """The library a header path (relative to the source root) belongs to, or None."""
+    """The library a header path (as included) belongs to, or None."""
     folder = os.path.dirname(path)
+    folder = INCLUDE_FOLDERS.get(folder, folder)
     for name, (lib_folder, _) in LAYERS.items():
         if folder == lib_folder:
             return name
@@ -45,6 +53,10 @@ def main():
             path = os.path.join(directory, entry)
             with open(path, encoding="utf-8") as f:
                 for number, line in enumerate(f, 1):
+                    system = SYSTEM_INCLUDE.match(line)
+                    if system and name == "public" and re.search(r"[./]", system.group(1)):
+                        # Only the C++ standard library (no Eigen, Ceres, ...): the header's users need nothing else.
+                        problems.append(f"{folder}/{entry}:{number}: the public header may include only standard headers, not <{system.group(1)}>")
                     m = INCLUDE.match(line)
                     if not m:
                         continue

@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install_deps.sh
-./scripts/build.sh
+./scripts/build.sh --target gins  # only what it runs: the test suite is scripts/test.sh's
 out=out/sample
 ./build/gins run --config config/default.yaml --log data/sample/log.txt.gz --truth data/sample/truth.csv.gz \
   --out "$out" --mode both

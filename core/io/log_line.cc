@@ -2,6 +2,7 @@
 // other line.
 #include <algorithm>
 #include <array>
+#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -199,17 +200,9 @@ LineParse CheckFieldCount(LogRecord::Type type, const char* const* names, size_t
   return LineParse::kRecord;
 }
 
-// Parses the n numbers after the type into v, then checks their ranges.
-LineParse ParseValues(const Tokens& tokens, LogRecord::Type type, const char* const* names, size_t n, double* v,
-                      InputIssue* issue) {
-  for (size_t i = 0; i < n; ++i) {
-    const NumberStatus status = ParseNumber(tokens.tok[i + 1], &v[i]);
-    if (status == NumberStatus::kOk) continue;
-    const std::string field =
-        "field " + std::to_string(i + 2) + " (" + names[i] + ") " + QuoteToken(tokens.tok[i + 1]);
-    if (status == NumberStatus::kBad) return Damaged(issue, kBadNumber, field + " is not a number");
-    return Damaged(issue, kNonFinite, field + " is not finite");
-  }
+// Range checks of a record's n finite numbers v (in log field order): one rule for parsed lines and for
+// records pushed through the API.
+LineParse CheckValues(LogRecord::Type type, size_t n, const double* v, InputIssue* issue) {
   if (!(v[0] > 0.0)) return Damaged(issue, kAbsurdValue, FieldValue(0, "t", v[0]) + ", time must be > 0");
   if (!(v[0] < log_limits::kMaxTime)) {
     return Damaged(issue, kAbsurdValue,
@@ -232,6 +225,20 @@ LineParse ParseValues(const Tokens& tokens, LogRecord::Type type, const char* co
   }
   if (!absurd.empty()) return Damaged(issue, kAbsurdValue, std::move(absurd));
   return LineParse::kRecord;
+}
+
+// Parses the n numbers after the type into v, then checks their ranges.
+LineParse ParseValues(const Tokens& tokens, LogRecord::Type type, const char* const* names, size_t n, double* v,
+                      InputIssue* issue) {
+  for (size_t i = 0; i < n; ++i) {
+    const NumberStatus status = ParseNumber(tokens.tok[i + 1], &v[i]);
+    if (status == NumberStatus::kOk) continue;
+    const std::string field =
+        "field " + std::to_string(i + 2) + " (" + names[i] + ") " + QuoteToken(tokens.tok[i + 1]);
+    if (status == NumberStatus::kBad) return Damaged(issue, kBadNumber, field + " is not a number");
+    return Damaged(issue, kNonFinite, field + " is not finite");
+  }
+  return CheckValues(type, n, v, issue);
 }
 
 void FillRecord(const double* v, size_t n, LogRecord* record) {
@@ -269,7 +276,55 @@ void FillRecord(const double* v, size_t n, LogRecord* record) {
   }
 }
 
+// The numbers of a record in log field order (the inverse of FillRecord), with their names; returns n.
+size_t RecordValues(const LogRecord& record, double* v, const char* const** names) {
+  switch (record.type) {
+    case LogRecord::Type::kImu: {
+      const ImuSample& m = record.imu;
+      *names = kImuFields;
+      const double values[] = {m.t, m.gyro.x(), m.gyro.y(), m.gyro.z(), m.acc.x(), m.acc.y(), m.acc.z()};
+      std::copy(std::begin(values), std::end(values), v);
+      return 7;
+    }
+    case LogRecord::Type::kOdom:
+      *names = kOdomFields;
+      v[0] = record.odom.t, v[1] = record.odom.left_pulses, v[2] = record.odom.right_pulses;
+      return 3;
+    case LogRecord::Type::kGnss: {
+      const GnssRecord& g = record.gnss;
+      *names = kGnssFields;
+      const double values[] = {g.t, g.lat_deg, g.lon_deg, g.alt_m, g.heading_deg, g.heading_valid ? 1.0 : 0.0,
+                               g.sigma_enu.x(), g.sigma_enu.y(), g.sigma_enu.z()};
+      std::copy(std::begin(values), std::end(values), v);
+      return g.has_sigma ? 9 : 6;
+    }
+    case LogRecord::Type::kGvel: {
+      const GvelRecord& g = record.gvel;
+      *names = kGvelFields;
+      const double values[] = {g.t, g.v_enu.x(), g.v_enu.y(), g.v_enu.z(), g.sigma_enu.x(), g.sigma_enu.y(),
+                               g.sigma_enu.z()};
+      std::copy(std::begin(values), std::end(values), v);
+      return g.has_sigma ? 7 : 4;
+    }
+  }
+  return 0;
+}
+
 }  // namespace
+
+LineParse CheckLogRecord(LogRecord* record, InputIssue* issue) {
+  double v[kMaxNumbers];
+  const char* const* names = nullptr;
+  const size_t n = RecordValues(*record, v, &names);
+  for (size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(v[i])) {
+      return Damaged(issue, kNonFinite, "field " + std::to_string(i + 2) + " (" + names[i] + ") is not finite");
+    }
+  }
+  if (CheckValues(record->type, n, v, issue) == LineParse::kDamaged) return LineParse::kDamaged;
+  FillRecord(v, n, record);  // as a parsed line: the heading normalised, unused fields zero
+  return LineParse::kRecord;
+}
 
 double LogRecord::t() const {
   switch (type) {

@@ -41,8 +41,11 @@ class LogReader::Impl {
  public:
   Impl(const std::string& path, const InputOptions& options, ReadStats* stats)
       : path_(path), options_(options), stats_(stats), lines_(path, options.max_line_length) {}
+  Impl(int fd, const std::string& name, const InputOptions& options, ReadStats* stats, int stop_fd)
+      : path_(name), options_(options), stats_(stats), lines_(fd, name, options.max_line_length, stop_fd) {}
 
   bool Next(LogRecord* record);
+  bool stopped() const { return lines_.stopped(); }
 
  private:
   // Handles a line that cannot be parsed as it stands (too long, or the cut last line); true if it was one.
@@ -118,9 +121,10 @@ void LogReader::Impl::CheckTime(const LogRecord& record, const char** reason, st
   const size_t k = static_cast<size_t>(record.type);
   const double t = record.t();
   const double max_jump = options_.max_time_jump;
-  if (have_newest_ && t < newest_t_) {
+  if (have_newest_ && t < newest_t_ - options_.reorder_window) {
     *reason = kOutOfOrder;
     *detail = "t = " + Time(t) + " is older than the newest time read, " + Time(newest_t_);
+    if (options_.reorder_window > 0.0) *detail += ", by more than input.reorder_window_s";
   } else if (have_newest_ && max_jump > 0.0 && t - newest_t_ > max_jump) {
     const bool agrees = jump_run_ > 0 && t >= jump_last_t_ && t - jump_last_t_ <= max_jump;
     jump_run_ = agrees ? jump_run_ + 1 : 1;
@@ -146,7 +150,8 @@ void LogReader::Impl::CheckTime(const LogRecord& record, const char** reason, st
 void LogReader::Impl::Accept(LogRecord* record, uint64_t line) {
   const size_t k = static_cast<size_t>(record->type);
   jump_run_ = 0;  // a record in time order ends any run of jumped ones
-  newest_t_ = record->t();
+  // Within the reorder window a record may be older than the newest one.
+  newest_t_ = have_newest_ ? std::max(newest_t_, record->t()) : record->t();
   have_newest_ = true;
   last_t_[k] = newest_t_;
   have_last_[k] = true;
@@ -213,7 +218,14 @@ LogReader::LogReader(const std::string& path, const InputOptions& options) : pat
   impl_ = std::make_unique<Impl>(path_, options_, &stats_);
 }
 
+LogReader::LogReader(int fd, const std::string& name, const InputOptions& options, int stop_fd)
+    : path_(name), options_(options) {
+  impl_ = std::make_unique<Impl>(fd, path_, options_, &stats_, stop_fd);
+}
+
 LogReader::~LogReader() = default;
+
+bool LogReader::stopped() const { return impl_->stopped(); }
 
 bool LogReader::Next(LogRecord* record) { return impl_->Next(record); }
 

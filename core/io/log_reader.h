@@ -8,8 +8,10 @@
 // unknown_type, out_of_order, duplicate, absurd_value, line_too_long, truncated (last line without
 // newline that does not parse, or a gzip stream cut short), time_jump.
 // Time: records must be non-decreasing in time over the whole file; records of different types may share
-// a time stamp in either order. A record older than the newest time read is out_of_order; a record of the
-// same type with the same time stamp as the previous one of that type is a duplicate. A record more than
+// a time stamp in either order. A record older than the newest time read by more than
+// input.reorder_window_s (default 0) is out_of_order; younger ones pass, and the API's reorder buffer
+// (gins/gins.h) sorts them into place by the same rule. A record of the same type with the same time stamp
+// as the previous one of that type is a duplicate. A record more than
 // input.max_time_jump_s ahead of the newest time read is a time_jump (a corrupted far-future time stamp
 // then costs one line, not every later one); after 10 consecutive records that all jumped and agree with
 // each other, the log's clock really jumped and the reader takes the new time base.
@@ -38,6 +40,8 @@ struct InputOptions {
   int max_line_length = 4096;        // input.max_line_length: characters; longer lines are damage
   double max_time_jump = 60.0;       // input.max_time_jump_s: a record this far ahead of the newest time is
                                      // damage (time_jump); 0 = no limit
+  double reorder_window = 0.0;       // input.reorder_window_s: a record this much older than the newest is
+                                     // sorted into place; older ones are out_of_order
 };
 
 // Plausibility limits of a log record (ParseLogLine). The reader sees only InputOptions, so they are fixed;
@@ -101,10 +105,18 @@ struct ReadStats {
 enum class LineParse { kRecord, kBlank, kDamaged };
 LineParse ParseLogLine(std::string_view line, LogRecord* record, InputIssue* issue);
 
+// The same checks on a record that did not come from a line (the API's pushes): every number finite, then
+// ParseLogLine's range checks; on success the record is made what ParseLogLine would have made of it (a
+// valid heading normalised into [0, 360), an invalid one 0). Returns kRecord or kDamaged with *issue filled.
+LineParse CheckLogRecord(LogRecord* record, InputIssue* issue);
+
 class LogReader {
  public:
   // Throws InputError if the file cannot be opened or read.
   LogReader(const std::string& path, const InputOptions& options);
+  // A stream read as it arrives (LineSource's fd constructor: plain text, each line handed on when its '\n'
+  // is read, the end at EOF or when stop_fd becomes readable); `name` stands for the path in messages.
+  LogReader(int fd, const std::string& name, const InputOptions& options, int stop_fd = -1);
   ~LogReader();
   LogReader(const LogReader&) = delete;
   LogReader& operator=(const LogReader&) = delete;
@@ -115,6 +127,8 @@ class LogReader {
 
   const ReadStats& stats() const { return stats_; }
   const std::string& path() const { return path_; }
+  // The stream ended because stop_fd became readable (not at EOF).
+  bool stopped() const;
 
  private:
   class Impl;

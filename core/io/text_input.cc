@@ -1,6 +1,7 @@
 #include "core/io/text_input.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -89,7 +90,48 @@ LineSource::LineSource(const std::string& path, int64_t max_line_length)
   gzbuffer(file, kChunk);  // before the first read
 }
 
+LineSource::LineSource(int fd, const std::string& name, int64_t max_line_length, int stop_fd)
+    : path_(name),
+      max_line_(static_cast<size_t>(std::clamp<int64_t>(max_line_length, 1, kMaxLineLengthCap))),
+      buf_(max_line_ + 2 + kChunk),
+      fd_(fd),
+      stop_fd_(stop_fd) {}
+
 LineSource::~LineSource() = default;
+
+// The data ends here, after the last complete line read: a fragment is a line cut by the stop, not data.
+void LineSource::Stop() {
+  const void* last = end_ > begin_ ? ::memrchr(buf_.data() + begin_, '\n', end_ - begin_) : nullptr;
+  end_ = last != nullptr ? static_cast<size_t>(static_cast<const char*>(last) - buf_.data()) + 1 : begin_;
+  eof_ = true;
+  stopped_ = true;
+}
+
+void LineSource::FillFromFd(size_t room) {
+  for (;;) {
+    if (stop_fd_ >= 0) {
+      pollfd fds[2] = {{fd_, POLLIN, 0}, {stop_fd_, POLLIN, 0}};
+      if (::poll(fds, 2, -1) < 0) {
+        if (errno == EINTR) continue;
+        read_errno_ = errno;
+        eof_ = true;
+        return;
+      }
+      if (fds[1].revents != 0) return Stop();  // before more data: the stop is for now, not after the backlog
+    }
+    const ssize_t n = ::read(fd_, buf_.data() + end_, room);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n < 0) read_errno_ = errno;
+      eof_ = true;
+      return;
+    }
+    end_ += static_cast<size_t>(n);
+    room -= static_cast<size_t>(n);
+    if (at_start_ && end_ < 3) continue;  // the first three bytes decide between text, BOM and gzip
+    return;
+  }
+}
 
 void LineSource::Fill() {
   if (begin_ > 0) {
@@ -98,6 +140,17 @@ void LineSource::Fill() {
     begin_ = 0;
   }
   const size_t room = buf_.size() - end_;  // >= kChunk: callers compact lines shorter than max_line_ + 2
+  if (fd_ >= 0) {
+    FillFromFd(room);
+    if (at_start_) {
+      at_start_ = false;
+      if (end_ >= 2 && static_cast<unsigned char>(buf_[0]) == 0x1f && static_cast<unsigned char>(buf_[1]) == 0x8b) {
+        throw InputError(path_ + ": gzip data; a stream is read as plain text (decompress it first, e.g. zcat)");
+      }
+      if (end_ >= 3 && std::memcmp(buf_.data(), "\xEF\xBB\xBF", 3) == 0) begin_ = 3;
+    }
+    return;
+  }
   errno = 0;
   const int n = gzread(file_.get(), buf_.data() + end_, static_cast<unsigned>(room));
   const int saved_errno = errno;

@@ -65,6 +65,12 @@ class LineSource {
   // Throws InputError("<path>: cannot open: <why>") if the file cannot be opened (or is a directory).
   // max_line_length is clamped to [1, 16 MiB].
   LineSource(const std::string& path, int64_t max_line_length);
+  // Lines of a pipe, socket or terminal as they arrive (`gins stream`'s stdin): each read returns what is
+  // there, so a line is handed on as soon as its '\n' is (a file's reads wait for a whole chunk). Plain
+  // text only (a live feed is not compressed: gzip data is refused with an InputError). fd stays open.
+  // When stop_fd (>= 0; e.g. a signalfd for SIGINT and SIGTERM) becomes readable, the data ends after the
+  // last complete line already read, and stopped() is true.
+  LineSource(int fd, const std::string& name, int64_t max_line_length, int stop_fd = -1);
   ~LineSource();
   LineSource(const LineSource&) = delete;
   LineSource& operator=(const LineSource&) = delete;
@@ -81,6 +87,8 @@ class LineSource {
   // The gzip stream was cut short or is corrupt: the data ended early; message() says how.
   bool stream_error() const { return stream_error_; }
   const std::string& stream_message() const { return stream_message_; }
+  // The data ended because stop_fd became readable.
+  bool stopped() const { return stopped_; }
 
  private:
   struct GzClose {
@@ -88,11 +96,15 @@ class LineSource {
   };
   bool SkipLongLine(TextLine* line);
   void Fill();
+  void FillFromFd(size_t room);
+  void Stop();
 
   const std::string path_;
   const size_t max_line_;
   std::vector<char> buf_;
-  std::unique_ptr<gzFile_s, GzClose> file_;
+  std::unique_ptr<gzFile_s, GzClose> file_;  // a file, or
+  int fd_ = -1, stop_fd_ = -1;                 // a stream read as it arrives
+  bool stopped_ = false;
   size_t begin_ = 0;  // unconsumed bytes are buf_[begin_, end_)
   size_t end_ = 0;
   bool at_start_ = true;  // nothing read yet (a UTF-8 BOM may follow)

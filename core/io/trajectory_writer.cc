@@ -82,14 +82,23 @@ TumWriter::TumWriter(const std::string& path, const std::string& mode, const Geo
   file_.Write(TrajectoryHeader(mode, origin));
 }
 
-bool TumWriter::Add(const NavState& x) {
+const char kStatesCsvColumns[] =
+    "t,px,py,pz,vx,vy,vz,qw,qx,qy,qz,bgx,bgy,bgz,bax,bay,baz,"
+    "sigma_px,sigma_py,sigma_pz,sigma_vx,sigma_vy,sigma_vz,sigma_att_e,sigma_att_n,sigma_att_u,odom_scale\n";
+
+bool WriteTumLine(FILE* f, const NavState& x) {
   if (!x.AllFinite()) return false;
   Line l;
   l.Fixed(x.t, 6);
   for (int i = 0; i < 3; ++i) l.Char(' ').Fixed(x.p_wb[i], 5);
   l.Char(' ').Fixed(x.q_wb.x(), 9).Char(' ').Fixed(x.q_wb.y(), 9).Char(' ').Fixed(x.q_wb.z(), 9);
   l.Char(' ').Fixed(x.q_wb.w(), 9).Char('\n');
-  l.WriteTo(file_.stream());
+  l.WriteTo(f);
+  return true;
+}
+
+bool TumWriter::Add(const NavState& x) {
+  if (!WriteTumLine(file_.stream(), x)) return false;
   ++count_;
   return true;
 }
@@ -97,12 +106,15 @@ bool TumWriter::Add(const NavState& x) {
 StatesCsvWriter::StatesCsvWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin)
     : file_(path) {
   file_.Write(TrajectoryHeader(mode, origin));
-  file_.Write(
-      "t,px,py,pz,vx,vy,vz,qw,qx,qy,qz,bgx,bgy,bgz,bax,bay,baz,"
-      "sigma_px,sigma_py,sigma_pz,sigma_vx,sigma_vy,sigma_vz,sigma_att_e,sigma_att_n,sigma_att_u,odom_scale\n");
+  file_.Write(kStatesCsvColumns);
 }
 
 bool StatesCsvWriter::Add(const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa, double odom_scale) {
+  return WriteStatesCsvLine(file_.stream(), x, sp, sv, sa, odom_scale);
+}
+
+bool WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa,
+                        double odom_scale) {
   if (!x.AllFinite() || !sp.allFinite() || !sv.allFinite() || !sa.allFinite() || !std::isfinite(odom_scale)) {
     return false;
   }
@@ -116,7 +128,7 @@ bool StatesCsvWriter::Add(const NavState& x, const Vec3& sp, const Vec3& sv, con
     for (int i = 0; i < 3; ++i) l.Char(',').Sci((*v)[i], 4);
   }
   l.Char(',').Fixed(odom_scale, 6).Char('\n');
-  l.WriteTo(file_.stream());
+  l.WriteTo(f);
   return true;
 }
 

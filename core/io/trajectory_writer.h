@@ -32,9 +32,15 @@ class AtomicFile {
 // Comment line naming the mode and the world frame's origin (DESIGN §4).
 std::string TrajectoryHeader(const std::string& mode, const GeodeticPoint& origin);
 
-// Neither writer ever writes a number that is not finite: a state with one is refused whole (Add returns
-// false, nothing written), so a NaN cannot reach an output file whatever the caller checked. Any finite value
-// fits its line, however large.
+// One line of each format (with its '\n') to any stream: the writers below and `gins stream`'s stdout
+// print the same bytes. Nothing is ever written with a number that is not finite: such a state is refused
+// whole (false, nothing written), so a NaN cannot reach an output whatever the caller checked. Any finite
+// value fits its line, however large.
+bool WriteTumLine(FILE* f, const NavState& x);
+bool WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att,
+                        double odom_scale);
+// The states CSV's column header line (after the TrajectoryHeader comment).
+extern const char kStatesCsvColumns[];
 
 // TUM trajectory: "t x y z qx qy qz qw" (body in w).
 class TumWriter {

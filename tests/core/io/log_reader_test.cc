@@ -4,6 +4,7 @@
 #include <zlib.h>
 
 #include <climits>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <random>
@@ -201,6 +202,26 @@ TEST_F(LogReaderTest, OlderRecordOfSameTypeAndTimeIsOutOfOrderNotDuplicate) {
   EXPECT_EQ(r.records.size(), 2u);
   EXPECT_EQ(r.stats.skipped.at("out_of_order"), 1u);
   EXPECT_EQ(r.stats.skipped.count("duplicate"), 0u);
+}
+
+// input.reorder_window_s: a record up to the window older than the newest passes (the API sorts it into
+// place); older is out_of_order, measured against the newest time, not the last record read.
+TEST_F(LogReaderTest, ReorderWindowLetsSlightlyOlderRecordsThrough) {
+  const std::string text = Imu("2.0") + "\nGNSS 1.7 31.5 120.4 10.5 170.9 1\n" + Imu("1.9") + "\n" + Imu("1.4") +
+                           "\n" + Imu("2.1") + "\n";
+  const ReadResult off = ReadAll(Write("log.txt", text));
+  EXPECT_EQ(off.records.size(), 2u);
+  EXPECT_EQ(off.stats.skipped.at("out_of_order"), 3u);
+  InputOptions window;
+  window.reorder_window = 0.5;
+  const ReadResult on = ReadAll(Write("log2.txt", text), window);
+  ASSERT_EQ(on.records.size(), 4u);
+  EXPECT_EQ(on.records[1].t(), 1.7);
+  EXPECT_EQ(on.records[2].t(), 1.9);
+  EXPECT_EQ(on.stats.skipped.at("out_of_order"), 1u);
+  ASSERT_EQ(on.stats.examples.size(), 1u);
+  EXPECT_EQ(on.stats.examples[0].line, 4u);
+  EXPECT_NE(on.stats.examples[0].detail.find("input.reorder_window_s"), std::string::npos);
 }
 
 // A corrupted far-future time stamp costs that one line: the records after it are read (not out_of_order).
@@ -603,6 +624,49 @@ TEST(LogReaderParseLogLineTest, ClassifiesLinesWithoutTheFile) {
   EXPECT_EQ(issue.reason, "missing_fields");
   ASSERT_EQ(ParseLogLine("ODOM 5 1 2 3 4 5 6 7 8 9 10 11 12 13", &record, &issue), LineParse::kDamaged);
   EXPECT_EQ(issue.reason, "extra_fields");
+}
+
+// Records pushed through the API get the line checks: a parsed record passes unchanged; NaN, absurd values
+// and a bad heading are damage; a valid heading is normalised as in a line.
+TEST(LogReaderCheckLogRecordTest, SameRulesAsALine) {
+  LogRecord record;
+  InputIssue issue;
+  for (const std::string& line : {Imu("7"), std::string("ODOM 5 1 2"), std::string("GNSS 6 31 120 3 -10 1 0.1 0.2 0.3"),
+                                 std::string("GNSS 6 31 120 3 999 0"), std::string("GVEL 8 1 2 3 0.1 0.1 0.2")}) {
+    ASSERT_EQ(ParseLogLine(line, &record, &issue), LineParse::kRecord) << line;
+    const LogRecord parsed = record;
+    ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kRecord) << line << ": " << issue.detail;
+    EXPECT_EQ(record.t(), parsed.t());
+    EXPECT_EQ(record.imu.gyro, parsed.imu.gyro);
+    EXPECT_EQ(record.gnss.heading_deg, parsed.gnss.heading_deg);
+    EXPECT_EQ(record.gnss.sigma_enu, parsed.gnss.sigma_enu);
+    EXPECT_EQ(record.gvel.v_enu, parsed.gvel.v_enu);
+  }
+  record = {};
+  record.type = LogRecord::Type::kGnss;
+  record.gnss = {6.0, 31.0, 120.0, 3.0, -10.0, true};
+  ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kRecord);
+  EXPECT_EQ(record.gnss.heading_deg, 350.0);
+  record.gnss.sigma_enu = Vec3(0.1, 0.0, 0.1);
+  record.gnss.has_sigma = true;
+  ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kDamaged);
+  EXPECT_EQ(issue.reason, "absurd_value");
+  EXPECT_NE(issue.detail.find("sigma_n"), std::string::npos) << issue.detail;
+
+  record = {};
+  record.imu.t = 1.0;
+  record.imu.gyro.y() = std::nan("");
+  ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kDamaged);
+  EXPECT_EQ(issue.reason, "non_finite");
+  EXPECT_NE(issue.detail.find("gy"), std::string::npos) << issue.detail;
+  record.imu.gyro.y() = 0.0;
+  record.imu.acc.z() = 1e4;
+  ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kDamaged);
+  EXPECT_EQ(issue.reason, "absurd_value");
+  record.imu.acc.z() = 9.8;
+  record.imu.t = 0.0;
+  ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kDamaged);
+  EXPECT_EQ(issue.reason, "absurd_value");
 }
 
 TEST(LogReaderStatsTest, TotalSkippedSumsAllReasons) {

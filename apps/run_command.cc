@@ -1,24 +1,23 @@
-#include "solver/runner.h"
+#include "apps/run_command.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
-#include <cmath>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "apps/api/access.h"
+#include "apps/api/convert.h"
 #include "core/eval/run_comparison.h"
 #include "core/geodesy.h"
 #include "core/io/batch_pipe.h"
-#include "core/io/log_reader.h"
 #include "core/io/trajectory_writer.h"
 #include "core/io/truth_reader.h"
-#include "solver/eskf.h"
-#include "solver/session.h"
-#include "solver/smoother.h"
 
 namespace gins {
 namespace {
@@ -40,13 +39,7 @@ class OutputStream {
   }
 
   void Add(const StateEstimate& e) {
-    if (!e.x.AllFinite() || !e.sigma_p.allFinite() || !e.sigma_v.allFinite() || !e.sigma_att.allFinite() ||
-        !std::isfinite(e.odom_scale)) {
-      ++non_finite_;  // never written (the writers refuse it too): a NaN must not reach an output
-      return;
-    }
-    if (e.x.t <= last_t_) return;  // one state per time stamp, in time order
-    last_t_ = e.x.t;
+    if (!filter_.Accept(e)) return;
     tum_.Add(e.x);
     if (states_) states_->Add(e.x, e.sigma_p, e.sigma_v, e.sigma_att, e.odom_scale);
   }
@@ -63,14 +56,13 @@ class OutputStream {
   }
 
   uint64_t count() const { return tum_.count(); }
-  uint64_t non_finite() const { return non_finite_; }
+  uint64_t non_finite() const { return filter_.non_finite(); }
 
  private:
   std::string name_;
   TumWriter tum_;
   std::unique_ptr<StatesCsvWriter> states_;
-  uint64_t non_finite_ = 0;
-  double last_t_ = -1e300;
+  StateFilter filter_;
 };
 
 using Streams = std::map<std::string, std::unique_ptr<OutputStream>>;
@@ -91,53 +83,9 @@ void CheckTruth(const std::string& path, const LocalEnuFrame& frame) {
   }
 }
 
-// Every record of the log to the session, in file order.
-void FeedLog(const RunOptions& options, const RunRequest& request, LogReader* reader, Session* session) {
-  LogRecord rec;
-  while (reader->Next(&rec)) {
-    switch (rec.type) {
-      case LogRecord::Type::kImu:
-        session->AddImu(rec.imu);
-        break;
-      case LogRecord::Type::kOdom:
-        session->AddOdom(rec.odom);
-        break;
-      case LogRecord::Type::kGnss:
-        session->AddGnss(rec.gnss);
-        break;
-      case LogRecord::Type::kGvel:
-        session->AddGvel(rec.gvel);
-        break;
-    }
-    if (!session->initialized() && session->elapsed() > options.init.max_wait) {
-      throw RunError(request.log_path + ": not initialised after " + std::to_string(options.init.max_wait) +
-                     " s (init.max_wait_s): " + session->Diagnosis());
-    }
-  }
-}
-
-// Fatal input: says what the file held, in one line (what was read, what was damaged and the first why).
-void CheckInput(const std::string& log_path, const ReadStats& rs, const Session& session) {
-  auto no_usable = [&](const std::string& what) {
-    if (rs.lines == 0) return RunError(log_path + ": empty log (no lines)");
-    std::string m = log_path + ": no usable " + what + " records (" + std::to_string(rs.lines) + " lines: " +
-                    std::to_string(rs.imu) + " IMU, " + std::to_string(rs.odom) + " ODOM, " +
-                    std::to_string(rs.gnss) + " GNSS, " +
-                    (rs.gvel > 0 ? std::to_string(rs.gvel) + " GVEL, " : std::string()) +
-                    std::to_string(rs.total_skipped()) + " damaged";
-    if (!rs.examples.empty()) {
-      m += "; first: line " + std::to_string(rs.examples.front().line) + ": " + rs.examples.front().reason + ": " +
-           rs.examples.front().detail;
-    }
-    return RunError(m + ")");
-  };
-  if (rs.imu == 0) throw no_usable("IMU");
-  if (rs.gnss == 0) throw no_usable("GNSS");
-  if (!session.initialized()) throw RunError(log_path + ": " + session.Diagnosis());
-}
-
 // summary.json's "input": what was read and skipped.
-nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nlohmann::json& session_stats) {
+nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nlohmann::json& session_stats,
+                         const api::Status& status) {
   nlohmann::json input;
   input["lines"] = rs.lines;
   input["records"] = {{"imu", rs.imu}, {"odom", rs.odom}, {"gnss", rs.gnss}, {"gvel", rs.gvel}};
@@ -155,13 +103,22 @@ nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nloh
   input["odom_ignored_wheel_disabled"] = session_stats["odom_ignored_wheel_disabled"];
   input["gvel_unused"] = session_stats["gvel_unused"];
   input["dropped_before_first_fix"] = session_stats["dropped_before_first_fix"];
+  // The API's reorder buffer (input.reorder_window_s): records sorted into place, and those refused (a
+  // log's late records are out_of_order damage above, so "refused" stays empty for a log).
+  nlohmann::json refused = nlohmann::json::object();
+  for (const api::Rejection& r : status.rejections) {
+    if (r.source == "input") refused[r.measurement][r.reason] = r.count;
+  }
+  input["reorder"] = {{"window_s", session_stats["session"]["reorder_window_s"]}, {"sorted", status.reordered}};
+  input["refused"] = refused;
   return input;
 }
 
 // The summary up to the outputs: the run, its input, the estimators, timing, and the GNSS outage windows
 // (simulated ones and the log's own gaps, absolute times) that the comparison scores the drift over.
-nlohmann::json RunSummary(const RunOptions& options, const RunRequest& request, const ReadStats& rs,
-                          const Session& session, const Streams& streams, Clock::time_point wall_start) {
+nlohmann::json RunSummary(const Options& options, const RunRequest& request, const ReadStats& rs,
+                          const api::Session& api_session, const Streams& streams, Clock::time_point wall_start) {
+  const Session& session = api::internal::Access::session(api_session);
   nlohmann::json j;
   j["gins_version"] = "0.1.0";
   j["mode"] = request.mode;
@@ -170,8 +127,8 @@ nlohmann::json RunSummary(const RunOptions& options, const RunRequest& request, 
   const GeodeticPoint& origin = session.frame()->origin();
   j["origin_lla"] = {origin.lat_deg, origin.lon_deg, origin.alt_m};
   j["gravity_m_s2"] = session.g_norm();
-  const nlohmann::json session_stats = session.Stats();
-  j["input"] = InputJson(rs, session, session_stats);
+  const nlohmann::json session_stats = api::internal::Access::stats(api_session);
+  j["input"] = InputJson(rs, session, session_stats, api_session.status());
   j["initialization"] = session_stats["initialization"];
   j["estimators"] = session_stats["estimators"];
   const double log_duration = session.last_time() - session.first_time();
@@ -223,54 +180,94 @@ void AddComparison(const RunRequest& request, const Session& session, const Stre
 
 std::vector<std::string> SupportedModes() { return {"eskf", "smoother", "both"}; }
 
-RunResult Run(const RunOptions& options, const RunRequest& request) {
+void CheckInitTimeout(const std::string& name, double max_wait, const api::Session& session) {
+  if (!session.init_timed_out()) return;
+  throw RunError(name + ": not initialised after " + std::to_string(max_wait) + " s (init.max_wait_s): " +
+                 api::internal::Access::session(session).Diagnosis());
+}
+
+void CheckReadCounts(const std::string& name, const ReadStats& rs) {
+  auto no_usable = [&](const std::string& what) {
+    if (rs.lines == 0) return RunError(name + ": empty log (no lines)");
+    std::string m = name + ": no usable " + what + " records (" + std::to_string(rs.lines) + " lines: " +
+                    std::to_string(rs.imu) + " IMU, " + std::to_string(rs.odom) + " ODOM, " +
+                    std::to_string(rs.gnss) + " GNSS, " +
+                    (rs.gvel > 0 ? std::to_string(rs.gvel) + " GVEL, " : std::string()) +
+                    std::to_string(rs.total_skipped()) + " damaged";
+    if (!rs.examples.empty()) {
+      m += "; first: line " + std::to_string(rs.examples.front().line) + ": " + rs.examples.front().reason + ": " +
+           rs.examples.front().detail;
+    }
+    return RunError(m + ")");
+  };
+  if (rs.imu == 0) throw no_usable("IMU");
+  if (rs.gnss == 0) throw no_usable("GNSS");
+}
+
+void FinishSession(const std::string& name, api::Session* session) {
+  try {
+    session->Finish();
+  } catch (const api::Error& e) {
+    if (e.kind() == api::Error::Kind::kNoSolution) throw RunError(name + ": " + e.what());
+    throw;
+  }
+}
+
+RunResult Run(const api::Config& config, const RunRequest& request) {
   const auto wall_start = Clock::now();
+  const Options& options = api::internal::Access::options(config);
   CheckMode(request.mode);
-  LogReader reader(request.log_path, options.input);
+  api::SessionOptions session_options;
+  api::ParseMode(request.mode, &session_options.mode);
+  session_options.geodetic = false;  // the outputs are in ENU
+  api::LogReader reader(request.log_path, config);
   std::error_code ec;
   std::filesystem::create_directories(request.out_dir, ec);
   if (ec) throw std::runtime_error(request.out_dir + ": cannot create output directory: " + ec.message());
 
-  Session session(options);
+  api::Session session(config, session_options);
+  const Session& internal = api::internal::Access::session(session);
   bool truth_checked = false;
   Streams streams;
+  std::array<OutputStream*, 3> by_stream{};  // indexed by api::Stream: no look-up per state
   // Formatting and writing the outputs runs on a second thread, in the order the states come: at IMU rate
   // it costs about as much as the ESKF. Declared after `streams`, so it is joined before they close.
-  BatchPipe<std::pair<OutputStream*, StateEstimate>> writer(
-      [](const std::pair<OutputStream*, StateEstimate>& item) { item.first->Add(item.second); });
+  BatchPipe<std::pair<OutputStream*, api::State>> writer([](const std::pair<OutputStream*, api::State>& item) {
+    item.first->Add(api::ToStateEstimate(item.second));
+  });
   // States arrive only after initialisation, when the world frame (and so the truth in it) exists.
-  auto stream_callback = [&](const std::string& name, bool with_states) {
-    return [&, name, with_states](const StateEstimate& e) {
-      auto& s = streams[name];
-      if (!s) {
-        if (request.truth_path && !truth_checked) {
-          CheckTruth(*request.truth_path, *session.frame());
-          truth_checked = true;
-        }
-        s = std::make_unique<OutputStream>(name, request.out_dir, *session.frame(), with_states);
+  session.OnState([&](const api::State& state) {
+    OutputStream*& out = by_stream[static_cast<size_t>(state.stream)];
+    if (out == nullptr) {
+      if (request.truth_path && !truth_checked) {
+        CheckTruth(*request.truth_path, *internal.frame());
+        truth_checked = true;
       }
-      writer.Push({s.get(), e});
-    };
-  };
-  if (request.mode == "eskf" || request.mode == "both") {
-    session.AddEstimator(std::make_unique<Eskf>(options, stream_callback("eskf", true)));
-  }
-  if (request.mode == "smoother" || request.mode == "both") {
-    session.AddEstimator(std::make_unique<Smoother>(options, stream_callback("smoother", true),
-                                                    stream_callback("smoother_online", false)));
-  }
+      const std::string name = api::StreamName(state.stream);
+      auto& s = streams[name];
+      s = std::make_unique<OutputStream>(name, request.out_dir, *internal.frame(),
+                                         state.stream != api::Stream::kSmootherOnline);
+      out = s.get();
+    }
+    writer.Push({out, state});
+  });
 
-  FeedLog(options, request, &reader, &session);
-  CheckInput(request.log_path, reader.stats(), session);
-  session.Finish();
+  const ReadStats& read_stats = api::internal::Access::read_stats(reader);
+  api::Record rec;
+  while (reader.Next(&rec)) {
+    session.Push(rec);
+    CheckInitTimeout(request.log_path, options.init.max_wait, session);
+  }
+  CheckReadCounts(request.log_path, read_stats);
+  FinishSession(request.log_path, &session);
   writer.Close();  // every state written (or the writer's error thrown) before the files are committed
 
   RunResult result;
   for (auto& [name, s] : streams) {
     for (auto& f : s->Commit(request.out_dir)) result.outputs.push_back(f);
   }
-  result.summary = RunSummary(options, request, reader.stats(), session, streams, wall_start);
-  AddComparison(request, session, streams, &result.summary, &result.accuracy);
+  result.summary = RunSummary(options, request, read_stats, session, streams, wall_start);
+  AddComparison(request, internal, streams, &result.summary, &result.accuracy);
 
   AtomicFile summary(request.out_dir + "/summary.json");
   summary.Write(result.summary.dump(2) + "\n");

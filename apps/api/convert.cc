@@ -1,0 +1,142 @@
+#include "apps/api/convert.h"
+
+namespace gins::api {
+namespace {
+
+Vec3 V(const double* a) { return Vec3(a[0], a[1], a[2]); }
+
+void Copy(const Vec3& v, double* out) {
+  out[0] = v.x();
+  out[1] = v.y();
+  out[2] = v.z();
+}
+
+}  // namespace
+
+LogRecord ToLogRecord(const Imu& m) {
+  LogRecord r;
+  r.type = LogRecord::Type::kImu;
+  r.imu = {m.t, V(m.gyro), V(m.acc)};
+  return r;
+}
+
+LogRecord ToLogRecord(const Wheel& m) {
+  LogRecord r;
+  r.type = LogRecord::Type::kOdom;
+  r.odom = {m.t, m.left_pulses, m.right_pulses};
+  return r;
+}
+
+LogRecord ToLogRecord(const Gnss& m) {
+  LogRecord r;
+  r.type = LogRecord::Type::kGnss;
+  r.gnss = {m.t, m.lat_deg, m.lon_deg, m.alt_m, m.heading_deg, m.heading_valid, m.has_sigma, V(m.sigma_enu)};
+  return r;
+}
+
+LogRecord ToLogRecord(const GnssVelocity& m) {
+  LogRecord r;
+  r.type = LogRecord::Type::kGvel;
+  r.gvel = {m.t, V(m.v_enu), m.has_sigma, V(m.sigma_enu)};
+  return r;
+}
+
+LogRecord ToLogRecord(const Record& r) {
+  LogRecord out;
+  switch (r.type) {
+    case Record::Type::kImu:
+      out = ToLogRecord(r.imu);
+      break;
+    case Record::Type::kWheel:
+      out = ToLogRecord(r.wheel);
+      break;
+    case Record::Type::kGnss:
+      out = ToLogRecord(r.gnss);
+      break;
+    case Record::Type::kGnssVelocity:
+      out = ToLogRecord(r.gnss_velocity);
+      break;
+  }
+  out.line = r.line;
+  return out;
+}
+
+Record ToRecord(const LogRecord& r) {
+  Record out;
+  out.line = r.line;
+  switch (r.type) {
+    case LogRecord::Type::kImu:
+      out.type = Record::Type::kImu;
+      out.imu.t = r.imu.t;
+      Copy(r.imu.gyro, out.imu.gyro);
+      Copy(r.imu.acc, out.imu.acc);
+      break;
+    case LogRecord::Type::kOdom:
+      out.type = Record::Type::kWheel;
+      out.wheel = {r.odom.t, r.odom.left_pulses, r.odom.right_pulses};
+      break;
+    case LogRecord::Type::kGnss: {
+      const GnssRecord& g = r.gnss;
+      out.type = Record::Type::kGnss;
+      out.gnss = {g.t, g.lat_deg, g.lon_deg, g.alt_m, g.heading_deg, g.heading_valid, g.has_sigma, {}};
+      Copy(g.sigma_enu, out.gnss.sigma_enu);
+      break;
+    }
+    case LogRecord::Type::kGvel:
+      out.type = Record::Type::kGnssVelocity;
+      out.gnss_velocity.t = r.gvel.t;
+      Copy(r.gvel.v_enu, out.gnss_velocity.v_enu);
+      out.gnss_velocity.has_sigma = r.gvel.has_sigma;
+      Copy(r.gvel.sigma_enu, out.gnss_velocity.sigma_enu);
+      break;
+  }
+  return out;
+}
+
+void ToState(Stream stream, const StateEstimate& e, State* out) {
+  out->stream = stream;
+  out->t = e.x.t;
+  Copy(e.x.p_wb, out->p_enu);
+  Copy(e.x.v_w, out->v_enu);
+  out->q_wb[0] = e.x.q_wb.w();
+  out->q_wb[1] = e.x.q_wb.x();
+  out->q_wb[2] = e.x.q_wb.y();
+  out->q_wb[3] = e.x.q_wb.z();
+  Copy(e.x.bg, out->gyro_bias);
+  Copy(e.x.ba, out->acc_bias);
+  Copy(e.sigma_p, out->sigma_p);
+  Copy(e.sigma_v, out->sigma_v);
+  Copy(e.sigma_att, out->sigma_att);
+  out->odom_scale = e.odom_scale;
+}
+
+StateEstimate ToStateEstimate(const State& s) {
+  StateEstimate e;
+  e.x.t = s.t;
+  e.x.p_wb = V(s.p_enu);
+  e.x.v_w = V(s.v_enu);
+  e.x.q_wb = Quat(s.q_wb[0], s.q_wb[1], s.q_wb[2], s.q_wb[3]);
+  e.x.bg = V(s.gyro_bias);
+  e.x.ba = V(s.acc_bias);
+  e.sigma_p = V(s.sigma_p);
+  e.sigma_v = V(s.sigma_v);
+  e.sigma_att = V(s.sigma_att);
+  e.odom_scale = s.odom_scale;
+  return e;
+}
+
+const char* MeasurementName(LogRecord::Type type) {
+  switch (type) {
+    case LogRecord::Type::kImu:
+      return "imu";
+    case LogRecord::Type::kOdom:
+      return "wheel";
+    case LogRecord::Type::kGnss:
+      return "gnss";
+    case LogRecord::Type::kGvel:
+      return "gnss_velocity";
+  }
+  return "?";
+}
+
+}  // namespace gins::api

@@ -1,0 +1,230 @@
+// api::Session (gins/gins.h): checks each pushed measurement as the log reader checks a line, sorts it in
+// through the reorder buffer, and feeds the internal session (solver/session.h) that owns the estimators;
+// their states come back through Emit, converted to the public State.
+#include <cmath>
+#include <deque>
+#include <exception>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "apps/api/access.h"
+#include "apps/api/convert.h"
+#include "apps/api/reorder_buffer.h"
+#include "gins/gins.h"
+#include "solver/eskf.h"
+#include "solver/smoother.h"
+
+namespace gins::api {
+
+class Session::Impl {
+ public:
+  Impl(const Options& options, const SessionOptions& session_options);
+  Impl(const Impl&) = delete;  // the estimators' callbacks hold `this`
+  Impl& operator=(const Impl&) = delete;
+
+  bool Push(LogRecord record);
+  void Finish();
+  void OnState(StateCallback callback) { callback_ = std::move(callback); }
+  bool Poll(State* state);
+  bool init_timed_out() const { return !session_.initialized() && session_.elapsed() > options_.init.max_wait; }
+  Status GetStatus() const;
+  nlohmann::json Stats() const;
+  const ::gins::Session& session() const { return session_; }
+
+ private:
+  void Dispatch(const LogRecord& r);
+  void Emit(Stream stream, const StateEstimate& e);
+  bool Reject(LogRecord::Type type, const std::string& reason);
+  void RethrowCallbackError();
+
+  const Options options_;
+  const SessionOptions session_options_;
+  ::gins::Session session_;
+  ReorderBuffer reorder_;
+  StateCallback callback_;
+  std::deque<State> queue_;
+  std::exception_ptr callback_error_;  // the first exception of the current call, rethrown at its end
+  bool finished_ = false;
+  InputIssue issue_;                                                  // reused: a valid record allocates nothing
+  std::map<std::pair<std::string, std::string>, uint64_t> rejected_;  // (measurement, reason) -> count
+  uint64_t accepted_ = 0, rejected_total_ = 0, states_ = 0, states_dropped_ = 0, callback_errors_ = 0;
+};
+
+Session::Impl::Impl(const Options& options, const SessionOptions& session_options)
+    : options_(options),
+      session_options_(session_options),
+      session_(options_),
+      reorder_(options_.input.reorder_window) {
+  const Mode mode = session_options_.mode;
+  if (mode == Mode::kEskf || mode == Mode::kBoth) {
+    session_.AddEstimator(std::make_unique<Eskf>(options_, [this](const StateEstimate& e) { Emit(Stream::kEskf, e); }));
+  }
+  if (mode == Mode::kSmoother || mode == Mode::kBoth) {
+    session_.AddEstimator(std::make_unique<Smoother>(
+        options_, [this](const StateEstimate& e) { Emit(Stream::kSmoother, e); },
+        [this](const StateEstimate& e) { Emit(Stream::kSmootherOnline, e); }));
+  }
+}
+
+bool Session::Impl::Push(LogRecord record) {
+  if (finished_) throw Error(Error::Kind::kUsage, "gins::api::Session: Push after Finish");
+  if (CheckLogRecord(&record, &issue_) == LineParse::kDamaged) return Reject(record.type, issue_.reason);
+  if (!reorder_.Add(record, [this](const LogRecord& r) { Dispatch(r); })) return Reject(record.type, "late");
+  ++accepted_;
+  RethrowCallbackError();
+  return true;
+}
+
+void Session::Impl::Dispatch(const LogRecord& r) {
+  switch (r.type) {
+    case LogRecord::Type::kImu:
+      session_.AddImu(r.imu);
+      break;
+    case LogRecord::Type::kOdom:
+      session_.AddOdom(r.odom);
+      break;
+    case LogRecord::Type::kGnss:
+      session_.AddGnss(r.gnss);
+      break;
+    case LogRecord::Type::kGvel:
+      session_.AddGvel(r.gvel);
+      break;
+  }
+}
+
+void Session::Impl::Finish() {
+  if (finished_) throw Error(Error::Kind::kUsage, "gins::api::Session: Finish called twice");
+  finished_ = true;
+  reorder_.Flush([this](const LogRecord& r) { Dispatch(r); });
+  try {
+    session_.Finish();
+  } catch (const RunError& e) {
+    throw Error(Error::Kind::kNoSolution, e.what());
+  }
+  RethrowCallbackError();
+}
+
+// Called by the estimators in the middle of their step: nothing may escape into them.
+void Session::Impl::Emit(Stream stream, const StateEstimate& e) {
+  State s;
+  ToState(stream, e, &s);
+  if (session_options_.geodetic) {
+    const GeodeticPoint g = session_.frame()->ToGeodetic(e.x.p_wb);
+    s.lla[0] = g.lat_deg, s.lla[1] = g.lon_deg, s.lla[2] = g.alt_m;
+  } else {
+    s.lla[0] = s.lla[1] = s.lla[2] = std::numeric_limits<double>::quiet_NaN();
+  }
+  ++states_;
+  if (!callback_) {
+    queue_.push_back(s);
+    if (queue_.size() > session_options_.max_queued_states) {
+      queue_.pop_front();
+      ++states_dropped_;
+    }
+    return;
+  }
+  try {
+    callback_(s);
+  } catch (...) {
+    ++callback_errors_;
+    if (!callback_error_) callback_error_ = std::current_exception();
+  }
+}
+
+void Session::Impl::RethrowCallbackError() {
+  if (callback_error_) std::rethrow_exception(std::exchange(callback_error_, nullptr));
+}
+
+bool Session::Impl::Reject(LogRecord::Type type, const std::string& reason) {
+  ++rejected_[{MeasurementName(type), reason}];
+  ++rejected_total_;
+  return false;
+}
+
+bool Session::Impl::Poll(State* state) {
+  if (queue_.empty()) return false;
+  *state = queue_.front();
+  queue_.pop_front();
+  return true;
+}
+
+Status Session::Impl::GetStatus() const {
+  Status s;
+  s.initialized = session_.initialized();
+  s.diagnosis = session_.Diagnosis();
+  s.init_timed_out = init_timed_out();
+  if (session_.frame()) {
+    const GeodeticPoint& o = session_.frame()->origin();
+    s.origin = Geodetic{o.lat_deg, o.lon_deg, o.alt_m};
+  }
+  if (session_.first_time() >= 0.0) {
+    s.first_time = session_.first_time();
+    s.last_time = session_.last_time();
+  }
+  s.accepted = accepted_;
+  s.reordered = reorder_.reordered();
+  s.rejected = rejected_total_;
+  s.states = states_;
+  s.states_dropped = states_dropped_;
+  s.callback_errors = callback_errors_;
+  for (const auto& [key, count] : rejected_) s.rejections.push_back({"input", key.first, key.second, count});
+  // Each estimator's counts (MeasurementCounts::ToJson: {"used", "rejected": {reason: n}, ...}).
+  const nlohmann::json stats = session_.Stats();
+  const nlohmann::json estimators = stats.value("estimators", nlohmann::json::object());
+  for (const auto& [name, est] : estimators.items()) {
+    for (const auto& [measurement, counts] : est.items()) {
+      if (!counts.is_object() || !counts.contains("rejected") || !counts["rejected"].is_object()) continue;
+      for (const auto& [reason, n] : counts["rejected"].items()) {
+        s.rejections.push_back({name, measurement, reason, n.get<uint64_t>()});
+      }
+    }
+    if (est.contains("watchdog")) s.watchdog_resets += est["watchdog"].value("count", uint64_t{0});
+  }
+  return s;
+}
+
+nlohmann::json Session::Impl::Stats() const {
+  nlohmann::json j = session_.Stats();
+  nlohmann::json rejected = nlohmann::json::object();
+  for (const auto& [key, count] : rejected_) rejected[key.first][key.second] = count;
+  j["session"] = {{"accepted", accepted_},
+                  {"reorder_window_s", reorder_.window()},
+                  {"reordered", reorder_.reordered()},
+                  {"rejected", rejected},
+                  {"states", states_},
+                  {"states_dropped", states_dropped_},
+                  {"callback_errors", callback_errors_}};
+  return j;
+}
+
+// --- Session ------------------------------------------------------------------------------------------------
+
+Session::Session(const Config& config, const SessionOptions& options)
+    : impl_(std::make_unique<Impl>(internal::Access::options(config), options)) {}
+
+Session::Session(const Config& config, Mode mode) : Session(config, SessionOptions{mode}) {}
+
+Session::~Session() = default;
+Session::Session(Session&&) noexcept = default;
+Session& Session::operator=(Session&&) noexcept = default;
+
+void Session::OnState(StateCallback callback) { impl_->OnState(std::move(callback)); }
+bool Session::Push(const Imu& imu) { return impl_->Push(ToLogRecord(imu)); }
+bool Session::Push(const Wheel& wheel) { return impl_->Push(ToLogRecord(wheel)); }
+bool Session::Push(const Gnss& fix) { return impl_->Push(ToLogRecord(fix)); }
+bool Session::Push(const GnssVelocity& velocity) { return impl_->Push(ToLogRecord(velocity)); }
+bool Session::Push(const Record& record) { return impl_->Push(ToLogRecord(record)); }
+void Session::Finish() { impl_->Finish(); }
+bool Session::Poll(State* state) { return impl_->Poll(state); }
+bool Session::initialized() const { return impl_->session().initialized(); }
+bool Session::init_timed_out() const { return impl_->init_timed_out(); }
+Status Session::status() const { return impl_->GetStatus(); }
+std::string Session::StatsJson() const { return impl_->Stats().dump(); }
+
+const ::gins::Session& internal::Access::session(const Session& session) { return session.impl_->session(); }
+nlohmann::json internal::Access::stats(const Session& session) { return session.impl_->Stats(); }
+
+}  // namespace gins::api

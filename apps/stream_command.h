@@ -1,0 +1,28 @@
+// `gins stream`: records on stdin, each state on stdout as soon as it is estimated, through the public API
+// (gins/gins.h) like `gins run`, so the numbers are the same; for live data and pipelines.
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace gins {
+
+struct StreamRequest {
+  std::string config_path;
+  std::string mode = "eskf";       // eskf | smoother
+  std::string out_format = "tum";  // tum | csv: the lines of `gins run`'s <stream>.tum or <stream>_states.csv
+  bool online = false;             // smoother: its causal estimate (smoother_online), not its final one
+};
+
+// Adds the `stream` subcommand to `app`, parsing into *req.
+CLI::App* AddStreamCommand(CLI::App& app, StreamRequest* req);
+
+// Reads in_fd to its end (or to SIGINT / SIGTERM, which end the input after its last complete line), writes
+// to out, flushed after every line, and a one-line report to stderr. Returns the exit code: 0 at the end of
+// the input or on a signal (what was read is processed and written), 1 for bad config or input or no
+// solution (one line on stderr, as `gins run`).
+int RunStream(const StreamRequest& req, int in_fd, std::FILE* out);
+
+}  // namespace gins

@@ -3,6 +3,7 @@
 #include <ceres/crs_matrix.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
@@ -32,28 +33,50 @@ using SpMat = Eigen::SparseMatrix<double>;
 // Columns `columns` of H⁻¹ (H the window's information, JᵀJ). The sparse LDLᵀ first (the common case, bit for
 // bit as before); it is accepted only with every pivot positive and every variance it gives positive and
 // finite. A window whose coasted interval (an IMU gap, a long outage) makes H ill-conditioned can give a
-// factorisation that "succeeds" with non-positive pivots (negative variances, NaN σ): then H is scaled to
-// unit diagonal and inverted through its eigen-decomposition, with eigenvalues floored at 1e-12 of the
-// largest (a direction the data do not constrain gets a large, finite variance). False only when H is not
-// finite.
+// factorisation that "succeeds" with non-positive pivots (negative variances, NaN σ): then the same on H
+// scaled to unit diagonal, and failing that (numerically singular) its eigen-decomposition with eigenvalues
+// floored at 1e-12 of the largest (a direction the data do not constrain gets a large, finite variance).
+// False only when H is not finite.
 bool InverseColumns(const SpMat& H, const std::vector<int>& columns, MatX* C) {
   const int m = static_cast<int>(columns.size());
   MatX E = MatX::Zero(H.rows(), m);
   for (int k = 0; k < m; ++k) E(columns[k], k) = 1.0;
-  const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(H);
-  if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > 0.0).all()) {
-    *C = ldlt.solve(E);
-    bool ok = ldlt.info() == Eigen::Success && C->allFinite();
-    for (int k = 0; ok && k < m; ++k) ok = (*C)(columns[k], k) > 0.0;
-    if (ok) return true;
+  const auto usable = [&](const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>>& ldlt) {
+    return ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > 0.0).all();
+  };
+  const auto positive = [&](const MatX& c) {
+    if (!c.allFinite()) return false;
+    for (int k = 0; k < m; ++k) {
+      if (!(c(columns[k], k) > 0.0)) return false;
+    }
+    return true;
+  };
+  {
+    const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(H);
+    if (usable(ldlt)) {
+      *C = ldlt.solve(E);
+      if (ldlt.info() == Eigen::Success && positive(*C)) return true;
+    }
   }
-  MatX Hd = H.toDense();
+  // Scaled to unit diagonal (the coasted interval's information is orders of magnitude below the rest).
+  VecX s = VecX::Ones(H.rows());
+  for (int i = 0; i < H.rows(); ++i) {
+    const double d = H.coeff(i, i);
+    if (d > 0.0 && std::isfinite(d)) s[i] = 1.0 / std::sqrt(d);
+  }
+  const SpMat Hs = s.asDiagonal() * H * s.asDiagonal();
+  {
+    const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(Hs);
+    if (usable(ldlt)) {
+      *C = s.asDiagonal() * ldlt.solve(MatX(s.asDiagonal() * E));
+      if (ldlt.info() == Eigen::Success && positive(*C)) return true;
+    }
+  }
+  // Numerically singular: the eigen-decomposition, eigenvalues floored.
+  MatX Hd = Hs.toDense();
   if (!Hd.allFinite()) return false;
   Hd = 0.5 * (Hd + Hd.transpose()).eval();
-  const VecX d = Hd.diagonal();
-  const VecX s = (d.array() > 0.0).select(d.array().rsqrt(), 1.0);
-  const MatX Hs = s.asDiagonal() * Hd * s.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<MatX> es(Hs);
+  const Eigen::SelfAdjointEigenSolver<MatX> es(Hd);
   if (es.info() != Eigen::Success) return false;
   const double floor = std::max(1e-12 * es.eigenvalues().maxCoeff(), 1e-300);
   const VecX inv = es.eigenvalues().cwiseMax(floor).cwiseInverse();

@@ -212,7 +212,7 @@ void AddComparison(const RunRequest& request, const Session& session, const Stre
 
 }  // namespace
 
-std::vector<std::string> SupportedModes() { return {"eskf", "smoother", "both"}; }
+std::vector<std::string> SupportedModes() { return {"eskf", "smoother", "both", "batch", "all"}; }
 
 void CheckInitTimeout(const std::string& name, double max_wait, const api::Session& session) {
   if (!session.init_timed_out()) return;
@@ -254,21 +254,23 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
   api::SessionOptions session_options;
   api::ParseMode(request.mode, &session_options.mode);
   session_options.geodetic = false;  // the outputs are in ENU
+  session_options.parallel = true;   // both and all: an estimator per core
   api::LogReader reader(request.log_path, config);
   std::error_code ec;
   std::filesystem::create_directories(request.out_dir, ec);
   if (ec) throw std::runtime_error(request.out_dir + ": cannot create output directory: " + ec.message());
 
-  api::Session session(config, session_options);
-  const Session& internal = api::internal::Access::session(session);
   bool truth_checked = false;
   Streams streams;
-  std::array<OutputStream*, 3> by_stream{};  // indexed by api::Stream: no look-up per state
+  std::array<OutputStream*, 5> by_stream{};  // indexed by api::Stream: no look-up per state
   // Formatting and writing the outputs runs on a second thread, in the order the states come: at IMU rate
   // it costs about as much as the ESKF. Declared after `streams`, so it is joined before they close.
   BatchPipe<std::pair<OutputStream*, api::State>> writer([](const std::pair<OutputStream*, api::State>& item) {
     item.first->Add(api::ToStateEstimate(item.second));
   });
+  // After what its callback uses: on an error the session (and its estimator threads) goes first.
+  api::Session session(config, session_options);
+  const Session& internal = api::internal::Access::session(session);
   // States arrive only after initialisation, when the world frame (and so the truth in it) exists.
   session.OnState([&](const api::State& state) {
     OutputStream*& out = by_stream[static_cast<size_t>(state.stream)];

@@ -124,6 +124,14 @@ inline constexpr auto kSmootherKeys = [](auto& v, SmootherOptions& o) {
   v.Number("bias_reintegrate_threshold", o.bias_reintegrate_threshold, kNoUnit, NonNegative());
 };
 
+inline constexpr auto kBatchKeys = [](auto& v, BatchOptions& o) {
+  v.Integer("max_iterations", o.max_iterations, 1);
+  v.Number("function_tolerance", o.function_tolerance, kNoUnit, Within(1e-15, 0.1));
+  v.Integer("max_relinearizations", o.max_relinearizations, 0);
+  v.Integer("max_segment_keyframes", o.max_segment_keyframes, 16);
+  v.Integer("segment_overlap_keyframes", o.segment_overlap_keyframes, 4);
+};
+
 inline constexpr auto kStandstillKeys = [](auto& v, StandstillOptions& o) {
   v.Boolean("enabled", o.enabled);
   v.Number("window_s", o.window, kNoUnit, Positive());
@@ -196,6 +204,7 @@ inline constexpr auto kOptionsKeys = [](auto& v, Options& o) {
   v.Section("init", o.init, kInitKeys);
   v.Section("eskf", o.eskf, kEskfKeys);
   v.Section("smoother", o.smoother, kSmootherKeys);
+  v.Section("batch", o.batch, kBatchKeys);
   v.Section("standstill", o.standstill, kStandstillKeys);
   v.Section("watchdog", o.watchdog, kWatchdogKeys);
   v.Section("simulate", o.simulate, kSimulateKeys);

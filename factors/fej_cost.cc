@@ -7,7 +7,11 @@
 
 namespace gins {
 
-FejCost::FejCost(ceres::CostFunction* inner, std::vector<Block> blocks) : inner_(inner), blocks_(std::move(blocks)) {
+FejCost::FejCost(ceres::CostFunction* inner, std::vector<Block> blocks)
+    : FejCost(std::shared_ptr<ceres::CostFunction>(inner), std::move(blocks)) {}
+
+FejCost::FejCost(std::shared_ptr<ceres::CostFunction> inner, std::vector<Block> blocks)
+    : inner_(std::move(inner)), blocks_(std::move(blocks)) {
   CHECK_EQ(blocks_.size(), inner_->parameter_block_sizes().size());
   CHECK_LE(blocks_.size(), static_cast<size_t>(kMaxBlocks));
   CHECK_LE(inner_->num_residuals(), kMaxResiduals);

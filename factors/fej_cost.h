@@ -33,13 +33,15 @@ class FejCost final : public ceres::CostFunction {
 
   // Takes ownership of inner; blocks[i] describes inner's parameter block i.
   FejCost(ceres::CostFunction* inner, std::vector<Block> blocks);
+  // Shares inner (the whole-log smoother keeps the window's factors after the window dropped them).
+  FejCost(std::shared_ptr<ceres::CostFunction> inner, std::vector<Block> blocks);
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
 
   const ceres::CostFunction& inner() const { return *inner_; }
 
  private:
-  std::unique_ptr<ceres::CostFunction> inner_;
+  std::shared_ptr<ceres::CostFunction> inner_;
   std::vector<Block> blocks_;
   PoseManifold manifold_;
 };

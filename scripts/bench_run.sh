@@ -38,7 +38,7 @@ median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[
   echo "| mode | log | wall (median of $runs) | min - max | real-time factor | peak RSS | horizontal RMSE | heading RMSE | outage drift max |"
   echo "|---|---|---|---|---|---|---|---|---|"
 } >"$out/results.md"
-for mode in eskf smoother both; do
+for mode in eskf smoother both batch all; do
   n=$runs
   [ "$mode" = both ] && n=1  # both = the two above in one process; shown once
   walls=()
@@ -55,8 +55,13 @@ for mode in eskf smoother both; do
   peak=$(printf '%s\n' "${rss[@]}" | sort -g | tail -1)
   # Accuracy of the last run's main output(s).
   files=()
-  [ "$mode" != smoother ] && files+=("$out/run_1h_$mode/eskf_states.csv")
-  [ "$mode" != eskf ] && files+=("$out/run_1h_$mode/smoother_states.csv")
+  case "$mode" in
+    eskf) files+=("$out/run_1h_$mode/eskf_states.csv") ;;
+    smoother) files+=("$out/run_1h_$mode/smoother_states.csv") ;;
+    both) files+=("$out/run_1h_$mode/eskf_states.csv" "$out/run_1h_$mode/smoother_states.csv") ;;
+    batch) files+=("$out/run_1h_$mode/batch_states.csv") ;;
+    all) for f in eskf eskf_rts smoother batch; do files+=("$out/run_1h_$mode/${f}_states.csv"); done ;;
+  esac
   $gins eval --truth "$out/drive_1h/truth.csv" --summary "$out/run_1h_$mode/summary.json" \
     --json "$out/eval_1h_$mode.json" "${files[@]}" >>"$raw"
   acc=$(/usr/bin/python3 - "$out/eval_1h_$mode.json" <<'PY'

@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """Plots of a gins run: PNG files written into the run directory.
 
-  trajectory.png      top-down view: truth, GNSS fixes (those dropped by simulated outages marked), ESKF,
-                      smoother; one zoomed panel per GNSS outage, where the estimators drift
+  trajectory.png      top-down view: truth, GNSS fixes (those dropped by simulated outages marked), every
+                      estimator the run wrote (ESKF, smoother, and with --mode all ESKF + RTS and batch);
+                      one zoomed panel per GNSS outage, where the estimators drift
   errors.png          horizontal error (log scale) and vertical error against time, outages shaded and
                       labelled with each estimator's largest drift                                  (truth)
   outage_drift.png    largest horizontal drift per outage and whole-run RMSEs, side by side        (truth)
@@ -29,9 +30,11 @@ from matplotlib.patches import Patch  # noqa: E402
 
 from gins_geo import lla_to_enu as to_enu, open_text, rot_enu_from_ecef as r_enu_ecef  # noqa: E402
 
-STYLE = {  # name: (label, colour)
+STYLE = {  # name: (label, colour); --mode all writes the four
     "eskf": ("ESKF", "tab:blue"),
     "smoother": ("smoother", "tab:orange"),
+    "eskf_rts": ("ESKF + RTS", "tab:cyan"),
+    "batch": ("batch", "tab:green"),
 }
 TRUTH_COLOUR = "black"
 OUTAGE_COLOUR = "tab:red"
@@ -158,7 +161,7 @@ def main():
             est[name]["p"] = np.stack([est[name]["px"], est[name]["py"], est[name]["pz"]], -1)
             est[name]["yaw"] = yaw_of(est[name])
     if not est:
-        print(f"plot_run: no eskf_states.csv or smoother_states.csv in {run}", file=sys.stderr)
+        print(f"plot_run: no eskf, smoother, eskf_rts or batch _states.csv in {run}", file=sys.stderr)
         return 1
     truth = read_truth(truth_path, origin) if truth_path else None
     fix_t, fix_p = read_fixes(log_path, origin) if log_path else (np.zeros(0), np.zeros((0, 3)))
@@ -314,7 +317,7 @@ def main():
             b2.set_xticks(np.arange(3), labels, fontsize=8)
             b2.set_title("Whole run (lower is better)")
             b2.grid(alpha=0.3, axis="y")
-            fig.suptitle(f"gins run {run_name}: ESKF against smoother", fontsize=10)
+            fig.suptitle(f"gins run {run_name}: " + ", ".join(STYLE[n][0] for n in est), fontsize=10)
             fig.tight_layout()
             save(fig, os.path.join(run, "outage_drift.png"), written)
 
@@ -342,7 +345,7 @@ def main():
     # ---- biases.png -----------------------------------------------------------------------------------
     fig, (g1, g2) = plt.subplots(2, 1, figsize=(12, 7), sharex=True)
     axis_colour = {"x": "tab:red", "y": "tab:green", "z": "tab:blue"}
-    dash = {"eskf": "-", "smoother": "--"}
+    dash = {"eskf": "-", "smoother": "--", "eskf_rts": "-.", "batch": ":"}
     for name, s in est.items():
         for ax_name in "xyz":
             g1.plot(s["t"] - t0, s["bg" + ax_name] * 180 / math.pi * 3600, color=axis_colour[ax_name],

@@ -24,8 +24,8 @@ constexpr double kZeroRateGateProbability = 0.9999;  // the gyro-reads-its-bias 
 
 }  // namespace
 
-Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state)
-    : options_(options), on_state_(std::move(on_state)), watchdog_(options.watchdog) {
+Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state, StateCallback on_rts)
+    : options_(options), on_state_(std::move(on_state)), on_rts_(std::move(on_rts)), watchdog_(options.watchdog) {
   gate_gnss_ = Chi2Gate(options_.gnss.gate_probability, 3);
   gate_heading_ = Chi2Gate(options_.gnss.gate_probability, 1);
   gate_wheel_ = Chi2Gate(options_.wheel.gate_probability, 1);
@@ -33,6 +33,14 @@ Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state)
   gate_wheel_yaw_ = Chi2Gate(options_.wheel.gate_probability, 1);
   gate_zupt_ = Chi2Gate(options_.wheel.gate_probability, 3);
   gate_zero_rate_ = Chi2Gate(kZeroRateGateProbability, 3);
+}
+
+Eskf::~Eskf() = default;
+
+void Eskf::Finish() {
+  if (!initialized_ || !rts_) return;
+  rts_->AfterUpdates(Nominal(), P_);
+  rts_->Smooth(earth_, on_rts_);
 }
 
 void Eskf::Initialize(const InitResult& init) {
@@ -59,12 +67,17 @@ void Eskf::Initialize(const InitResult& init) {
   gnss_inflation_.Accepted();
   watchdog_.Clear();
   initialized_ = true;
+  if (on_rts_) {
+    rts_ = std::make_unique<EskfRts>(options_);
+    rts_->StartChain(Nominal(), P_);
+  }
   if (on_state_) on_state_(Estimate());
 }
 
 void Eskf::Propagate(double t, const ImuSample* held) {
   const double dt = t - x_.t;
   if (dt <= 0.0) return;
+  if (rts_) rts_->AfterUpdates(Nominal(), P_);  // the updates at x_.t are done
   if (held == nullptr && last_imu_) held = &*last_imu_;
   // Across an IMU gap, coast: no rotation, no acceleration (the held sample says nothing about the gap). The
   // gap is judged from the newest sample, whatever the state's time, and a step no sample covers (a fix
@@ -76,7 +89,16 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   const Vec3 acc = gap ? Vec3(x_.q_wb.conjugate() * (2.0 * rate_w.cross(x_.v_w) - g_w)) : Vec3(held->acc - x_.ba);
   Kinematics k{x_.q_wb, x_.v_w, x_.p_wb};
   ImuStepJacobians J;
-  k = ImuStep(k, omega, acc, g_w, dt, gap ? nullptr : &J, rate_w);
+  k = ImuStep(k, omega, acc, g_w, dt, &J, rate_w);
+  if (gap) {
+    // The coast's transition (CoastCovariance): its errors depend on neither the attitude nor the biases.
+    J.A.block<3, 3>(0, 6).setZero();
+    J.A.block<3, 3>(3, 6).setZero();
+    J.A.block<3, 3>(6, 6).setIdentity();
+    J.B.setZero();
+    J.G.setZero();
+  }
+  if (rts_) rts_->Step(J, omega + x_.bg, acc + x_.ba, x_.t, dt);
   a_w_ = (k.v - x_.v_w) / dt;
   x_.q_wb = k.q;
   x_.v_w = k.v;
@@ -203,6 +225,9 @@ bool Eskf::Update(const Model<M>& model, const Eigen::Matrix<double, M, M>& R, d
   // Iterated update (IKFoM): at iterate x_i = x̂ ⊞ δ the prior is N(−δ, P_i) in x_i's tangent, with P_i
   // the prior covariance carried there (its δθ rows and columns by Jr(δθ)); the Gauss-Newton step from x_i
   // is e = −δ − K_i·(r_i − H_i·δ). One iteration is the classic ESKF update.
+  // The prior undoubted: the RTS gain P⁺Φᵀ(P⁻)⁻¹ needs P⁻ consistent with the chain before it (an
+  // inflation that doubts both alike leaves the gain unchanged; one on P⁻ alone would cut it).
+  if (rts_) rts_->BeforeUpdate(Nominal(), P_);
   const NavState x0 = x_;
   const Vec3 dg0 = dg_w_;
   const double s0 = scale_;
@@ -280,6 +305,7 @@ bool Eskf::WatchGnss(const GnssMeasurement& m, bool accepted) {
 }
 
 void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
+  if (rts_) rts_->AfterUpdates(Nominal(), P_);  // the chain before the re-initialisation ends here
   const bool finite = x_.AllFinite() && P_.allFinite();
   if (!finite) {
     x_.q_wb = FallbackAttitude(m, options_);
@@ -303,6 +329,7 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
   watchdog_.Reset(m.t, reason);
   LOG(WARNING) << "eskf watchdog: re-initialised from GNSS at t=" << std::fixed << m.t << " (" << reason
                << (have_velocity ? "; velocity from the last two fixes" : "; velocity kept") << ")";
+  if (rts_) rts_->StartChain(Nominal(), P_);
   if (on_state_) on_state_(Estimate());
 }
 
@@ -335,6 +362,7 @@ nlohmann::json Eskf::Stats() const {
   j["final_gravity"] = {g_w.x(), g_w.y(), g_w.z()};
   j["final_gyro_bias_deg_h"] = {x_.bg.x() * kRadToDeg * 3600, x_.bg.y() * kRadToDeg * 3600, x_.bg.z() * kRadToDeg * 3600};
   j["final_acc_bias_m_s2"] = {x_.ba.x(), x_.ba.y(), x_.ba.z()};
+  if (rts_) j["rts"] = rts_->Stats();
   return j;
 }
 

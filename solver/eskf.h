@@ -31,12 +31,14 @@
 
 #include <functional>
 #include <initializer_list>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/imu_kernel.h"
+#include "solver/eskf_rts.h"
 #include "solver/eskf_state.h"
 #include "solver/eskf_update.h"
 #include "solver/estimator.h"
@@ -49,7 +51,9 @@ class Eskf : public Estimator {
   using MatP = Eigen::Matrix<double, eskf::kDim, eskf::kDim>;
   using VecP = Eigen::Matrix<double, eskf::kDim, 1>;
 
-  Eskf(const EstimatorOptions& options, StateCallback on_state);
+  // on_rts (optional): the Rauch-Tung-Striebel smoothed stream (solver/eskf_rts.h), emitted at Finish.
+  Eskf(const EstimatorOptions& options, StateCallback on_state, StateCallback on_rts = nullptr);
+  ~Eskf() override;
 
   std::string name() const override { return "eskf"; }
   void Initialize(const InitResult& init) override;
@@ -58,7 +62,7 @@ class Eskf : public Estimator {
   void AddGvel(const GvelMeasurement& gvel) override;
   void AddWheel(const WheelMeasurement& wheel) override;
   void AddStandstill(const StandstillMeasurement& m) override;
-  void Finish() override {}
+  void Finish() override;
   nlohmann::json Stats() const override;
 
   const NavState& state() const { return x_; }
@@ -114,8 +118,12 @@ class Eskf : public Estimator {
   bool WatchGnss(const GnssMeasurement& m, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
 
+  EskfNominal Nominal() const { return {x_, dg_w_, scale_}; }
+
   EstimatorOptions options_;
   StateCallback on_state_;
+  StateCallback on_rts_;
+  std::unique_ptr<EskfRts> rts_;  // with on_rts_
   bool initialized_ = false;
   NavState x_;
   EarthModel earth_;

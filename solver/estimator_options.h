@@ -29,6 +29,15 @@ struct SmootherOptions {
   double bias_reintegrate_threshold = 1e-3;  // smoother.bias_reintegrate_threshold (norm of δb)
 };
 
+// batch.*: the whole-log smoother (--mode batch; solver/batch_smoother.h).
+struct BatchOptions {
+  int max_iterations = 50;          // batch.max_iterations
+  double function_tolerance = 1e-9;  // batch.function_tolerance: stop when |Δcost|/cost falls below
+  int max_relinearizations = 2;     // batch.max_relinearizations: IMU re-integration rounds at the solution
+  int max_segment_keyframes = 20000;     // batch.max_segment_keyframes: longer logs are solved in segments
+  int segment_overlap_keyframes = 200;   // batch.segment_overlap_keyframes: the segments' overlap
+};
+
 // watchdog.*: divergence detection and re-initialisation from GNSS.
 struct WatchdogOptions {
   bool enabled = true;                // watchdog.enabled
@@ -40,6 +49,7 @@ struct WatchdogOptions {
 struct EstimatorOptions : InitializerOptions {
   EskfOptions eskf;
   SmootherOptions smoother;
+  BatchOptions batch;
   StandstillOptions standstill;
   WatchdogOptions watchdog;
 };

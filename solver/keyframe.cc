@@ -10,6 +10,7 @@
 #include "factors/bias_rw_factor.h"
 #include "factors/fej_cost.h"
 #include "factors/scale_rw_factor.h"
+#include "solver/factor_log.h"
 
 namespace gins {
 
@@ -107,8 +108,15 @@ KeyframeStore::KeyframeStore(const EstimatorOptions& options) : options_(options
 }
 
 void KeyframeStore::Reset(ceres::Problem* problem) {
-  window_.clear();
+  Clear();
   problem_ = problem;
+}
+
+void KeyframeStore::Clear() {
+  if (log_ != nullptr) {
+    for (auto& kf : window_) log_->Keep(std::move(kf));
+  }
+  window_.clear();
 }
 
 std::unique_ptr<Keyframe> KeyframeStore::Make(double t, const NavState& x) const {
@@ -155,6 +163,7 @@ Keyframe& KeyframeStore::Push(std::unique_ptr<Keyframe> kf) {
 void KeyframeStore::PopOldest() {
   CHECK(!window_.empty());
   for (double* b : Blocks(front())) CHECK(!problem_->HasParameterBlock(b)) << "PopOldest: blocks still in the problem";
+  if (log_ != nullptr) log_->Keep(std::move(window_.front()));
   window_.pop_front();
 }
 
@@ -191,12 +200,36 @@ std::vector<BlockType> KeyframeStore::EstimatedTypes() const {
 ceres::ResidualBlockId KeyframeStore::AddFactor(ceres::CostFunction* cost, ceres::LossFunction* loss,
                                                 const std::vector<BlockRef>& blocks) {
   std::vector<FejCost::Block> fej;
-  std::vector<double*> params;
   for (const BlockRef& ref : blocks) {
     fej.push_back({ref.kf->first_estimate(ref.type), &ref.kf->fej, SpecOf(ref.type).kind == BlockKind::kPose});
-    params.push_back(ref.kf->block(ref.type));
   }
-  return problem_->AddResidualBlock(new FejCost(cost, std::move(fej)), loss, params);
+  std::shared_ptr<ceres::CostFunction> shared(cost);
+  return AddLogged(shared, new FejCost(shared, std::move(fej)), loss, blocks);
+}
+
+ceres::ResidualBlockId KeyframeStore::AddMeasurement(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                                                     const std::vector<BlockRef>& blocks, double gate) {
+  const ceres::ResidualBlockId id = AddFactor(cost, loss, blocks);
+  if (log_ != nullptr) log_->SetGate(last_logged_, gate);
+  return id;
+}
+
+void KeyframeStore::LogRejected(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                                const std::vector<BlockRef>& blocks, double gate) {
+  std::shared_ptr<ceres::CostFunction> owned(cost);
+  if (log_ == nullptr) return;
+  LoggedFactor f{std::move(owned), loss, blocks, false};
+  f.gate = gate;
+  log_->Add(std::move(f));
+}
+
+ceres::ResidualBlockId KeyframeStore::AddLogged(std::shared_ptr<ceres::CostFunction> cost,
+                                                ceres::CostFunction* in_problem, ceres::LossFunction* loss,
+                                                const std::vector<BlockRef>& blocks) {
+  std::vector<double*> params;
+  for (const BlockRef& ref : blocks) params.push_back(ref.kf->block(ref.type));
+  if (log_ != nullptr) last_logged_ = log_->Add({std::move(cost), loss, blocks, true});
+  return problem_->AddResidualBlock(in_problem, loss, params);
 }
 
 ceres::ResidualBlockId KeyframeStore::AddPrior(Keyframe& kf, const Mat15& P0) {
@@ -232,8 +265,11 @@ ceres::ResidualBlockId KeyframeStore::AddPrior(Keyframe& kf, const Mat15& P0) {
     b.x0.assign(kf.block(type), kf.block(type) + spec.ambient_size);
     blocks.push_back(std::move(b));
   }
-  return problem_->AddResidualBlock(new MarginalizationPrior(std::move(blocks), J, VecX::Zero(n)), nullptr,
-                                    EstimatedBlocks(kf));
+  // The problem owns what it is given; the log keeps its own copy of the prior.
+  std::vector<BlockRef> refs;
+  for (BlockType type : types) refs.push_back({&kf, type});
+  auto logged = std::make_shared<MarginalizationPrior>(blocks, J, VecX::Zero(n));
+  return AddLogged(std::move(logged), new MarginalizationPrior(std::move(blocks), J, VecX::Zero(n)), nullptr, refs);
 }
 
 void KeyframeStore::AddRandomWalks(Keyframe& prev, Keyframe& kf) {

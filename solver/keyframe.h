@@ -128,6 +128,7 @@ struct Keyframe {
   std::shared_ptr<const Preintegration> preint;  // previous keyframe -> this one
   std::vector<HeldImuSample> steps_from_prev;    // for the IMU-rate output between keyframes
   ceres::ResidualBlockId imu_id = nullptr;       // the IMU factor from the previous keyframe
+  size_t imu_log_index = 0;                      // and its entry in the factor log, when one is kept
   bool still_from_prev = false;  // stood still since the previous keyframe (a zero-motion factor joins them)
 
   double* block(BlockType type) { return values + AmbientOffset(type); }
@@ -144,6 +145,8 @@ struct BlockRef {
   BlockType type;
 };
 
+class FactorLog;
+
 // The window's keyframes, oldest first, and their blocks in a Ceres problem.
 class KeyframeStore {
  public:
@@ -151,6 +154,12 @@ class KeyframeStore {
 
   // Empties the window; the blocks of the keyframes pushed from now on go to `problem` (not owned).
   void Reset(ceres::Problem* problem);
+  // From now on every factor and prior added, and every keyframe leaving the window, also goes to `log`
+  // (not owned; null: none, the default).
+  void SetLog(FactorLog* log) { log_ = log; }
+  FactorLog* log() const { return log_; }
+  // The log index of the factor or prior added last (with a log).
+  size_t last_logged() const { return last_logged_; }
   ceres::Problem* problem() const { return problem_; }
   bool estimated(BlockType type) const { return estimated_[static_cast<int>(type)]; }
 
@@ -163,7 +172,7 @@ class KeyframeStore {
   // Drops the oldest keyframe; its residuals and blocks must be out of the problem already (Marginalizer:
   // residuals first, in program order, for determinism).
   void PopOldest();
-  void Clear() { window_.clear(); }
+  void Clear();
 
   size_t size() const { return window_.size(); }
   bool empty() const { return window_.empty(); }
@@ -187,6 +196,13 @@ class KeyframeStore {
   // block linearises at its keyframe's first estimate once the keyframe has one.
   ceres::ResidualBlockId AddFactor(ceres::CostFunction* cost, ceres::LossFunction* loss,
                                    const std::vector<BlockRef>& blocks);
+  // A measurement's factor, as AddFactor, that the whole-log smoother re-checks with gate (χ²).
+  ceres::ResidualBlockId AddMeasurement(ceres::CostFunction* cost, ceres::LossFunction* loss,
+                                        const std::vector<BlockRef>& blocks, double gate);
+  // A measurement the window rejected: kept in the log (inactive) for the whole-log smoother to re-check,
+  // nothing added to the problem. Takes ownership of cost; without a log it is deleted.
+  void LogRejected(ceres::CostFunction* cost, ceres::LossFunction* loss, const std::vector<BlockRef>& blocks,
+                   double gate);
   // The covariance P0 (NavState tangent order) as a prior on kf's estimated blocks; a block outside
   // NavState gets its spec's prior_sigma, uncorrelated.
   ceres::ResidualBlockId AddPrior(Keyframe& kf, const Mat15& P0);
@@ -202,6 +218,11 @@ class KeyframeStore {
   PoseManifold pose_manifold_;
   std::deque<std::unique_ptr<Keyframe>> window_;
   uint64_t next_id_ = 0;
+  FactorLog* log_ = nullptr;
+  size_t last_logged_ = 0;
+  // Adds to the problem and, with a log, records.
+  ceres::ResidualBlockId AddLogged(std::shared_ptr<ceres::CostFunction> cost, ceres::CostFunction* in_problem,
+                                   ceres::LossFunction* loss, const std::vector<BlockRef>& blocks);
 };
 
 }  // namespace gins

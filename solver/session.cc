@@ -1,6 +1,12 @@
 #include "solver/session.h"
 
+#include <atomic>
 #include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <thread>
 
 #include "core/wheel_model.h"
 
@@ -16,13 +22,111 @@ Session::Session(const EstimatorOptions& options) : options_(options) {
 
 void Session::AddEstimator(std::unique_ptr<Estimator> estimator) { estimators_.push_back({std::move(estimator), {}}); }
 
-template <typename F>
-void Session::Dispatch(F&& f) {
-  for (auto& te : estimators_) {
+// One estimator's thread: batches of tasks in order, a bounded queue (the reader waits rather than buffer
+// the log), the first exception kept for the caller.
+struct Session::Worker {
+  static constexpr size_t kBatch = 256;     // tasks handed over at once
+  static constexpr size_t kMaxQueued = 64;  // batches waiting before the caller waits
+
+  explicit Worker(Timed* te) : target(te), thread([this] { Run(); }) {}
+  void Submit(bool force) {
+    if (pending.empty() || (!force && pending.size() < kBatch)) return;
+    std::unique_lock<std::mutex> lock(mutex);
+    space.wait(lock, [&] { return queue.size() < kMaxQueued; });
+    queue.push_back(std::move(pending));
+    pending.clear();
+    pending.reserve(kBatch);
+    ready.notify_one();
+  }
+  // Runs what was handed over and ends the thread; cancel: drops it instead (the session is being
+  // destroyed without Finish, after an error: the callbacks' owners may be gone).
+  void Stop(bool cancel = false) {
+    if (!cancel) Submit(true);
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      done = true;
+      if (cancel) {
+        queue.clear();
+        cancelled = true;
+      }
+    }
+    ready.notify_one();
+    if (thread.joinable()) thread.join();
+  }
+  void Run() {
+    for (;;) {
+      std::vector<std::function<void(Estimator&)>> batch;
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        ready.wait(lock, [&] { return !queue.empty() || done; });
+        if (queue.empty()) return;
+        batch = std::move(queue.front());
+        queue.pop_front();
+      }
+      space.notify_one();
+      const auto t0 = std::chrono::steady_clock::now();
+      for (auto& task : batch) {
+        if (error || cancelled) break;  // failed (the caller rethrows at Finish) or cancelled
+        try {
+          task(*target->estimator);
+        } catch (...) {
+          error = std::current_exception();
+        }
+      }
+      target->time += std::chrono::steady_clock::now() - t0;
+    }
+  }
+
+  Timed* target;
+  std::vector<std::function<void(Estimator&)>> pending;
+  std::mutex mutex;
+  std::condition_variable ready, space;
+  std::deque<std::vector<std::function<void(Estimator&)>>> queue;
+  bool done = false;
+  std::atomic<bool> cancelled{false};
+  std::exception_ptr error;  // written by the thread, read after Stop
+  std::thread thread;        // last: starts once the members above exist
+};
+
+Session::~Session() { CancelThreads(); }
+
+void Session::CancelThreads() {
+  for (auto& w : workers_) w->Stop(true);
+  workers_.clear();
+}
+
+template <typename M>
+void Session::Dispatch(void (Estimator::*add)(const M&), const M& m) {
+  DispatchTask([add, m](Estimator& e) { (e.*add)(m); });
+}
+
+void Session::DispatchTask(const std::function<void(Estimator&)>& task) {
+  if (parallel_ && workers_.empty() && estimators_.size() > 1) {
+    // estimators_ no longer grows (the first record came): its elements keep their addresses.
+    for (size_t i = 1; i < estimators_.size(); ++i) workers_.push_back(std::make_unique<Worker>(&estimators_[i]));
+  }
+  for (size_t i = 0; i < estimators_.size(); ++i) {
+    if (i > 0 && !workers_.empty()) {
+      Worker& w = *workers_[i - 1];
+      w.pending.push_back(task);
+      w.Submit(false);
+      continue;
+    }
+    Timed& te = estimators_[i];
     const auto t0 = std::chrono::steady_clock::now();
-    f(*te.estimator);
+    task(*te.estimator);
     te.time += std::chrono::steady_clock::now() - t0;
   }
+}
+
+void Session::StopWorkers() {
+  std::exception_ptr error;
+  for (auto& w : workers_) {
+    w->Stop();
+    if (!error) error = w->error;
+  }
+  workers_.clear();
+  if (error) std::rethrow_exception(error);
 }
 
 void Session::Touch(double t) {
@@ -96,7 +200,7 @@ void Session::AddImu(const ImuSample& raw) {
   } else if (!initialized_) {
     init_->AddImu(s);
   } else {
-    Dispatch([&](Estimator& e) { e.AddImu(s); });
+    Dispatch(&Estimator::AddImu, s);
   }
   if (standstill_) {
     standstill_->AddImu(s);
@@ -116,7 +220,7 @@ void Session::DetectStandstill(double t) {
   last_standstill_sent_ = t;
   ++standstill_sent_;
   const StandstillMeasurement m{t, standing_since_};
-  Dispatch([&](Estimator& e) { e.AddStandstill(m); });
+  Dispatch(&Estimator::AddStandstill, m);
 }
 
 void Session::AddOdom(const OdomRecord& o) {
@@ -137,7 +241,7 @@ void Session::AddOdom(const OdomRecord& o) {
   } else if (!initialized_) {
     init_->AddWheel(w);
   } else {
-    Dispatch([&](Estimator& e) { e.AddWheel(w); });
+    Dispatch(&Estimator::AddWheel, w);
   }
 }
 
@@ -195,10 +299,10 @@ void Session::AddGnss(const GnssRecord& g) {
     init_->AddGnss(m);
     if (init_->done()) {
       initialized_ = true;
-      Dispatch([&](Estimator& e) { e.Initialize(init_->result()); });
+      Dispatch(&Estimator::Initialize, init_->result());
     }
   } else {
-    Dispatch([&](Estimator& e) { e.AddGnss(m); });
+    Dispatch(&Estimator::AddGnss, m);
   }
 }
 
@@ -213,7 +317,7 @@ void Session::AddGvel(const GvelRecord& g) {
   m.t = g.t;
   m.v_w = frame_->RotationFromLocalEnu(*last_fix_geo_) * g.v_enu;
   m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options_.gnss.min_velocity_sigma) : options_.gnss.velocity_sigma_enu;
-  Dispatch([&](Estimator& e) { e.AddGvel(m); });
+  Dispatch(&Estimator::AddGvel, m);
 }
 
 // --- Simulated GNSS outages ---------------------------------------------------------------------------------
@@ -236,7 +340,8 @@ std::string Session::Diagnosis() const {
 
 void Session::Finish() {
   if (!initialized_) throw RunError(Diagnosis());
-  Dispatch([&](Estimator& e) { e.Finish(); });
+  DispatchTask([](Estimator& e) { e.Finish(); });
+  StopWorkers();
 }
 
 nlohmann::json Session::Stats() const {
@@ -260,7 +365,9 @@ nlohmann::json Session::Stats() const {
                        {"fixes_dropped", outage_dropped_},
                        {"fixes_kept_before_initialization", outage_kept_before_init_},
                        {"log_gaps", gaps}};
-  for (const auto& te : estimators_) {
+  for (size_t i = 0; i < estimators_.size(); ++i) {
+    const Timed& te = estimators_[i];
+    if (i > 0 && !workers_.empty()) continue;  // running on its thread: its counts after Finish
     j["estimators"][te.estimator->name()] = te.estimator->Stats();
     j["estimator_time_s"][te.estimator->name()] = std::chrono::duration<double>(te.time).count();
   }

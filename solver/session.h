@@ -5,6 +5,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -32,8 +33,17 @@ class RunError : public std::runtime_error {
 class Session {
  public:
   explicit Session(const EstimatorOptions& options);
+  ~Session();
 
   void AddEstimator(std::unique_ptr<Estimator> estimator);
+  // Runs every estimator after the first on a thread of its own (before the first record; with one
+  // estimator it changes nothing). The estimators share nothing and each sees the same records in the same
+  // order, so every stream is what the sequential run gives, bit for bit; their callbacks then come from
+  // those threads (one thread per estimator, so one stream's states still come in order).
+  void SetParallel(bool parallel) { parallel_ = parallel; }
+  // Stops the estimators' threads now, dropping what they have not run (a run abandoned on an error: the
+  // owner of their callbacks calls it before it goes away). The destructor does it too.
+  void CancelThreads();
 
   void AddImu(const ImuSample& raw);
   void AddOdom(const OdomRecord& odom);
@@ -58,8 +68,14 @@ class Session {
  private:
   void Touch(double t);
   void EnsureInitializer();
-  template <typename F>
-  void Dispatch(F&& f);
+  // Hands a copy of the measurement to every estimator (a member function of Estimator taking it).
+  template <typename M>
+  void Dispatch(void (Estimator::*add)(const M&), const M& m);
+  void DispatchTask(const std::function<void(Estimator&)>& task);
+  void StopWorkers();
+  struct Worker;
+  bool parallel_ = false;
+  std::vector<std::unique_ptr<Worker>> workers_;  // estimators_[i + 1] runs on workers_[i] when parallel
 
   EstimatorOptions options_;
   std::optional<LocalEnuFrame> frame_;

@@ -9,6 +9,7 @@
 #include "core/imu_kernel.h"
 #include "core/so3.h"
 #include "factors/imu_factor.h"
+#include "solver/batch_smoother.h"
 #include "solver/marginalizer.h"
 #include "solver/smoother_gate.h"
 #include "solver/smoother_output.h"
@@ -23,10 +24,13 @@ double Seconds(std::chrono::steady_clock::duration d) { return std::chrono::dura
 
 }  // namespace
 
-Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, StateCallback on_online)
+Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, StateCallback on_online,
+                   StateCallback on_batch)
     : options_(options),
       on_final_(std::move(on_final)),
       on_online_(std::move(on_online)),
+      on_batch_(std::move(on_batch)),
+      factor_log_(on_batch_ ? std::make_unique<FactorLog>() : nullptr),
       window_(options),
       context_{window_,
                options_,
@@ -34,8 +38,10 @@ Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, Stat
                last_imu_,
                [this](double t) { return PredictAt(t); },
                [this](double t) { return AnchorAt(t); },
-               [this]() -> const MatX* { return newest_two_cov_.size() > 0 ? &newest_two_cov_ : nullptr; }},
+               [this]() -> const MatX* { return newest_two_cov_.size() > 0 ? &newest_two_cov_ : nullptr; },
+               [this](double t) { return PartialAt(t); }},
       watchdog_(options.watchdog) {
+  window_.SetLog(factor_log_.get());
   attachers_.push_back(std::make_unique<VehicleAttacher>(options_));
   attachers_.push_back(std::make_unique<StandstillAttacher>(options_));
   attachers_.push_back(std::make_unique<GvelAttacher>(options_));
@@ -181,6 +187,13 @@ Anchor Smoother::AnchorAt(double t) {
   return {&newest, std::make_shared<const Preintegration>(*preint_)};
 }
 
+Anchor Smoother::PartialAt(double t) {
+  Keyframe& newest = window_.back();
+  IntegrateTo(t);
+  if (std::abs(t - newest.t) <= kSameEpoch || preint_->dt() <= 0.0) return {&newest, nullptr};
+  return {&newest, std::make_shared<const Preintegration>(*preint_)};
+}
+
 void Smoother::UpdateNewestCovariance(MatX* oldest_cov) {
   const size_t n = window_.size();
   std::vector<size_t> which;
@@ -237,6 +250,7 @@ Keyframe& Smoother::CreateKeyframe(double t) {
   made->steps_from_prev = interval_samples_;
   Keyframe& kf = window_.Push(std::move(made));
   kf.imu_id = AddImuFactor(prev, kf);
+  kf.imu_log_index = window_.last_logged();
   window_.AddRandomWalks(prev, kf);
   preint_ = std::make_shared<Preintegration>(pred_.bg, pred_.ba, options_.imu.gyro_noise_density,
                                              options_.imu.acc_noise_density);
@@ -329,6 +343,8 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
   cov.diagonal() = cov.diagonal().cwiseMax(1e-12);
   init.P0 = cov;
 
+  // The chain the whole-log smoother sees ends at the newest keyframe, with the IMU steps after it.
+  if (factor_log_ && finite) factor_log_->SetTail(&window_.back(), interval_samples_);
   const std::optional<ImuSample> last_imu = last_imu_;
   const double last_sample_t = last_sample_t_;
   Initialize(init);  // a fresh problem and window; emits the new keyframe on the online stream
@@ -414,8 +430,10 @@ void Smoother::ReintegrateIfNeeded() {
     auto fresh = std::make_shared<Preintegration>(*kf.preint);
     fresh->Reintegrate(bg, ba);
     problem_->RemoveResidualBlock(kf.imu_id);
+    if (factor_log_) factor_log_->Deactivate(kf.imu_log_index);
     kf.preint = fresh;
     kf.imu_id = AddImuFactor(prev, kf);
+    kf.imu_log_index = window_.last_logged();
     ++reintegrations_;
   }
 }
@@ -468,8 +486,15 @@ void Smoother::Finish() {
   Mat15 cov = Mat15::Zero();
   const bool have_cov = OldestCovariance(window_, &cov);
   OutputFinal(window_.front(), nullptr, have_cov ? &cov : nullptr);
+  if (factor_log_) factor_log_->SetTail(&window_.front(), interval_samples_);
   window_.Clear();
   initialized_ = false;
+  if (on_batch_) {
+    BatchSmoother batch(options_, window_.EstimatedTypes());
+    batch.Solve(factor_log_.get(), earth_);
+    batch.Emit(*factor_log_, earth_, on_batch_);
+    batch_stats_ = batch.stats().ToJson();
+  }
 }
 
 nlohmann::json Smoother::Stats() const {
@@ -490,6 +515,7 @@ nlohmann::json Smoother::Stats() const {
   j["final_odom_scale"] = last_scale_;
   imu_gaps_.ToJson(&j);
   j["watchdog"] = watchdog_.ToJson();
+  if (on_batch_) j["batch"] = batch_stats_;
   return j;
 }
 

@@ -36,6 +36,7 @@
 #include "factors/pose_manifold.h"
 #include "solver/estimator.h"
 #include "solver/estimator_options.h"
+#include "solver/factor_log.h"
 #include "solver/keyframe.h"
 #include "solver/smoother_attachers.h"
 
@@ -43,7 +44,10 @@ namespace gins {
 
 class Smoother : public Estimator {
  public:
-  Smoother(const EstimatorOptions& options, StateCallback on_final, StateCallback on_online);
+  // on_batch (optional): the whole-log solution (solver/batch_smoother.h), emitted at Finish; the window
+  // then keeps every factor and keyframe it built.
+  Smoother(const EstimatorOptions& options, StateCallback on_final, StateCallback on_online,
+           StateCallback on_batch = nullptr);
   ~Smoother() override;
 
   std::string name() const override { return "smoother"; }
@@ -65,6 +69,7 @@ class Smoother : public Estimator {
   // The attachers' services (AttachContext): the prediction at t, and the keyframe policy's anchor.
   Prediction PredictAt(double t);
   Anchor AnchorAt(double t);
+  Anchor PartialAt(double t);
   // Solves the window if measurements joined it since the last solve.
   void SolveIfPending();
   // The joint covariance of the two newest keyframes (or the newest alone) after a solve.
@@ -90,6 +95,9 @@ class Smoother : public Estimator {
   Vec3 g_w_ = Vec3::Zero();  // gravity at the newest prediction (the attachers read it)
   bool initialized_ = false;
 
+  StateCallback on_batch_;
+  std::unique_ptr<FactorLog> factor_log_;  // with on_batch_; before window_, which records into it
+  nlohmann::json batch_stats_;
   KeyframeStore window_;
   std::unique_ptr<ceres::Problem> problem_;  // after window_: the problem goes first, its blocks are there
 

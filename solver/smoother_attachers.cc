@@ -72,6 +72,17 @@ bool GnssAttacher::OnGnss(const GnssMeasurement& m, const AttachContext& ctx) {
   return position;
 }
 
+ceres::CostFunction* GnssAttacher::PositionFactor(const GnssMeasurement& m, const Prediction& pred, const Anchor& a,
+                                                  const AttachContext& ctx, std::vector<BlockRef>* blocks) const {
+  if (a.partial == nullptr) {
+    *blocks = {{a.kf, BlockType::kPose}};
+    return GnssFactor::Create(m.p_w, m.sigma_w, options_.gnss.lever_b);
+  }
+  *blocks = {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}};
+  return PreintAttachedFactor<GnssAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb),
+                                                  GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), options_.gnss.lever_b});
+}
+
 bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx) {
   const std::vector<BlockType> types = ctx.keyframes.EstimatedTypes();
   const StateBlocks at(pred.x);
@@ -83,6 +94,12 @@ bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pr
       inflation > 1.0 ? CheckFactor(*check_cost, {at.pose.data()}, {BlockKind::kPose}, inflation * sigma) : plain;
   if (!check.Passes(gate_position_)) {
     position_counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
+    if (ctx.keyframes.log() != nullptr && check.evaluated) {
+      const Anchor a = ctx.partial(m.t);
+      std::vector<BlockRef> blocks;
+      ceres::CostFunction* cost = PositionFactor(m, pred, a, ctx, &blocks);
+      ctx.keyframes.LogRejected(cost, loss_position_.get(), blocks, gate_position_);
+    }
     if (plain.evaluated) {
       Vec3 innovation;
       Mat3 S;
@@ -98,15 +115,9 @@ bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pr
   }
   inflation_.Accepted();
   const Anchor a = ctx.anchor(m.t);
-  if (a.partial == nullptr) {
-    ctx.keyframes.AddFactor(GnssFactor::Create(m.p_w, m.sigma_w, options_.gnss.lever_b), loss_position_.get(),
-                            {{a.kf, BlockType::kPose}});
-  } else {
-    ctx.keyframes.AddFactor(
-        PreintAttachedFactor<GnssAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb),
-                                                 GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), options_.gnss.lever_b}),
-        loss_position_.get(), {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}});
-  }
+  std::vector<BlockRef> blocks;
+  ceres::CostFunction* cost = PositionFactor(m, pred, a, ctx, &blocks);
+  ctx.keyframes.AddMeasurement(cost, loss_position_.get(), blocks, gate_position_);
   ++position_counts_.used;
   on_checked_(m.t, true);
   return true;
@@ -119,21 +130,26 @@ void GnssAttacher::AttachHeading(const GnssMeasurement& m, const Prediction& pre
       HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw));
   const FactorCheck check = CheckFactor(*check_cost, {at.pose.data()}, {BlockKind::kPose},
                                         SubCovariance(types, pred.cov, {BlockType::kPose}));
+  const auto factor = [&](const Anchor& a, std::vector<BlockRef>* blocks) -> ceres::CostFunction* {
+    if (a.partial == nullptr) {
+      *blocks = {{a.kf, BlockType::kPose}};
+      return HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw);
+    }
+    *blocks = {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}};
+    return PreintAttachedFactor<HeadingAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb),
+                                                       HeadingAtTime{m.yaw_G, 1.0 / m.sigma_yaw, options_.gnss.mount_yaw});
+  };
+  std::vector<BlockRef> blocks;
   if (!check.Passes(gate_heading_)) {
     heading_counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
+    if (ctx.keyframes.log() != nullptr && check.evaluated) {
+      ceres::CostFunction* cost = factor(ctx.partial(m.t), &blocks);
+      ctx.keyframes.LogRejected(cost, loss_heading_.get(), blocks, gate_heading_);
+    }
     return;
   }
-  const Anchor a = ctx.anchor(m.t);
-  if (a.partial == nullptr) {
-    ctx.keyframes.AddFactor(HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw),
-                            loss_heading_.get(), {{a.kf, BlockType::kPose}});
-  } else {
-    ctx.keyframes.AddFactor(
-        PreintAttachedFactor<HeadingAtTime>::Create(
-            a.partial, ctx.EarthTermsAt(pred.x.p_wb),
-            HeadingAtTime{m.yaw_G, 1.0 / m.sigma_yaw, options_.gnss.mount_yaw}),
-        loss_heading_.get(), {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}});
-  }
+  ceres::CostFunction* cost = factor(ctx.anchor(m.t), &blocks);
+  ctx.keyframes.AddMeasurement(cost, loss_heading_.get(), blocks, gate_heading_);
   ++heading_counts_.used;
 }
 

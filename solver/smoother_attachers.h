@@ -64,6 +64,9 @@ struct AttachContext {
   std::function<Anchor(double t)> anchor;
   // After the last solve: the joint covariance of the two newest keyframes (older first), or null.
   std::function<const MatX*()> newest_two_cov;
+  // The newest keyframe and the IMU preintegrated from it to t, never a new keyframe: where a measurement
+  // the window rejects is kept for the whole-log smoother (only with a factor log).
+  std::function<Anchor(double t)> partial;
   // The Earth terms of an IMU interval around p (gravity there, Earth rate).
   ImuEarthTerms EarthTermsAt(const Vec3& p_w) const;
   // The body's rate against w from the last IMU sample, with the biases of x.
@@ -102,6 +105,9 @@ class GnssAttacher final : public MeasurementAttacher {
   void AddStats(nlohmann::json* stats) const override;
 
  private:
+  // The position factor of m at anchor a (at its keyframe, or through the IMU preintegrated from it).
+  ceres::CostFunction* PositionFactor(const GnssMeasurement& m, const Prediction& pred, const Anchor& a,
+                                      const AttachContext& ctx, std::vector<BlockRef>* blocks) const;
   bool AttachPosition(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
   void AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
 

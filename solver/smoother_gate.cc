@@ -81,7 +81,7 @@ MatX SubCovariance(const std::vector<BlockType>& types, const MatX& cov, const s
 }
 
 FactorCheck CheckFactor(const ceres::CostFunction& cost, const std::vector<const double*>& params,
-                        const std::vector<BlockKind>& kinds, const MatX& sigma) {
+                        const std::vector<BlockKind>& kinds, const MatX& sigma, bool posterior) {
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   FactorCheck c;
   const int m = cost.num_residuals();
@@ -109,7 +109,7 @@ FactorCheck CheckFactor(const ceres::CostFunction& cost, const std::vector<const
     col += tangent;
   }
   if (!J.allFinite() || col != sigma.cols()) return c;
-  c.S = J * sigma * J.transpose() + MatX::Identity(m, m);
+  c.S = (posterior ? -1.0 : 1.0) * (J * sigma * J.transpose()) + MatX::Identity(m, m);
   const Eigen::LLT<MatX> llt(c.S);
   if (llt.info() != Eigen::Success) return c;
   c.chi2 = c.residual.dot(llt.solve(c.residual));

@@ -37,7 +37,9 @@ struct FactorCheck {
   MatX S;                  // whitened innovation covariance
   bool Passes(double gate) const { return evaluated && chi2 <= gate; }
 };
+// posterior: Σ is of a solution the factor is part of, so the residual's covariance is I − J·Σ·Jᵀ (the
+// post-fit check of a used measurement) instead of I + J·Σ·Jᵀ.
 FactorCheck CheckFactor(const ceres::CostFunction& cost, const std::vector<const double*>& params,
-                        const std::vector<BlockKind>& kinds, const MatX& sigma);
+                        const std::vector<BlockKind>& kinds, const MatX& sigma, bool posterior = false);
 
 }  // namespace gins

@@ -23,6 +23,7 @@ struct DriveRun {
   std::vector<double> truth_t;  // the truth at every IMU record
   std::vector<NavState> truth;
   std::vector<StateEstimate> eskf, smoother, smoother_online;
+  std::vector<StateEstimate> eskf_rts, batch;  // with smoothing: the two-sided streams
   bool initialized = false;
   double first_t = 0.0, init_t = 0.0;
   nlohmann::json stats;  // Session::Stats()
@@ -36,17 +37,22 @@ using RecordHook = std::function<void(const SimRecord& rec, const std::function<
 
 inline DriveRun RunDriveThroughSession(const SimOptions& sim, const EstimatorOptions& options,
                                        const RecordHook& hook = nullptr, bool with_eskf = true,
-                                       bool with_smoother = true) {
+                                       bool with_smoother = true, bool with_smoothing = false) {
   DriveRun out;
   Simulator simulator(sim);
   Session session(options);
   if (with_eskf) {
-    session.AddEstimator(std::make_unique<Eskf>(options, [&](const StateEstimate& e) { out.eskf.push_back(e); }));
+    StateCallback rts;
+    if (with_smoothing) rts = [&](const StateEstimate& e) { out.eskf_rts.push_back(e); };
+    session.AddEstimator(
+        std::make_unique<Eskf>(options, [&](const StateEstimate& e) { out.eskf.push_back(e); }, std::move(rts)));
   }
   if (with_smoother) {
+    StateCallback batch;
+    if (with_smoothing) batch = [&](const StateEstimate& e) { out.batch.push_back(e); };
     session.AddEstimator(std::make_unique<Smoother>(
         options, [&](const StateEstimate& e) { out.smoother.push_back(e); },
-        [&](const StateEstimate& e) { out.smoother_online.push_back(e); }));
+        [&](const StateEstimate& e) { out.smoother_online.push_back(e); }, std::move(batch)));
   }
   const std::function<void(const SimRecord&)> feed = [&](const SimRecord& r) { FeedSession(&session, r); };
   SimRecord rec;

@@ -36,12 +36,16 @@ const char* ModeName(Mode mode) {
       return "smoother";
     case Mode::kBoth:
       return "both";
+    case Mode::kBatch:
+      return "batch";
+    case Mode::kAll:
+      return "all";
   }
   return "?";
 }
 
 bool ParseMode(const std::string& name, Mode* mode) {
-  for (const Mode m : {Mode::kEskf, Mode::kSmoother, Mode::kBoth}) {
+  for (const Mode m : {Mode::kEskf, Mode::kSmoother, Mode::kBoth, Mode::kBatch, Mode::kAll}) {
     if (name == ModeName(m)) {
       *mode = m;
       return true;
@@ -58,6 +62,10 @@ const char* StreamName(Stream stream) {
       return "smoother";
     case Stream::kSmootherOnline:
       return "smoother_online";
+    case Stream::kBatch:
+      return "batch";
+    case Stream::kEskfRts:
+      return "eskf_rts";
   }
   return "?";
 }

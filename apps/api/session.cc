@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 
@@ -22,6 +23,8 @@ namespace gins::api {
 class Session::Impl {
  public:
   Impl(const Options& options, const SessionOptions& session_options);
+  // The estimators' threads stop before the members their callbacks use (Emit) go.
+  ~Impl() { session_.CancelThreads(); }
   Impl(const Impl&) = delete;  // the estimators' callbacks hold `this`
   Impl& operator=(const Impl&) = delete;
 
@@ -51,6 +54,9 @@ class Session::Impl {
   InputIssue issue_;                                                  // reused: a valid record allocates nothing
   std::map<std::pair<std::string, std::string>, uint64_t> rejected_;  // (measurement, reason) -> count
   uint64_t accepted_ = 0, rejected_total_ = 0, states_ = 0, states_dropped_ = 0, callback_errors_ = 0;
+  // Emit may come from the estimators' threads (SessionOptions::parallel): it, the queue and the counters
+  // it keeps are under this lock.
+  mutable std::mutex emit_mutex_;
 };
 
 Session::Impl::Impl(const Options& options, const SessionOptions& session_options)
@@ -58,14 +64,24 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
       session_options_(session_options),
       session_(options_),
       reorder_(options_.input.reorder_window) {
+  session_.SetParallel(session_options_.parallel);
   const Mode mode = session_options_.mode;
-  if (mode == Mode::kEskf || mode == Mode::kBoth) {
-    session_.AddEstimator(std::make_unique<Eskf>(options_, [this](const StateEstimate& e) { Emit(Stream::kEskf, e); }));
+  const bool all = mode == Mode::kAll;
+  if (mode == Mode::kEskf || mode == Mode::kBoth || all) {
+    ::gins::StateCallback rts;
+    if (all) rts = [this](const StateEstimate& e) { Emit(Stream::kEskfRts, e); };
+    session_.AddEstimator(std::make_unique<Eskf>(
+        options_, [this](const StateEstimate& e) { Emit(Stream::kEskf, e); }, std::move(rts)));
   }
-  if (mode == Mode::kSmoother || mode == Mode::kBoth) {
+  if (mode == Mode::kSmoother || mode == Mode::kBoth || mode == Mode::kBatch || all) {
+    // Batch alone: the window runs as the batch's forward pass, its own streams not delivered.
+    const bool window = mode != Mode::kBatch;
+    ::gins::StateCallback batch;
+    if (mode == Mode::kBatch || all) batch = [this](const StateEstimate& e) { Emit(Stream::kBatch, e); };
     session_.AddEstimator(std::make_unique<Smoother>(
-        options_, [this](const StateEstimate& e) { Emit(Stream::kSmoother, e); },
-        [this](const StateEstimate& e) { Emit(Stream::kSmootherOnline, e); }));
+        options_, window ? ::gins::StateCallback([this](const StateEstimate& e) { Emit(Stream::kSmoother, e); }) : nullptr,
+        window ? ::gins::StateCallback([this](const StateEstimate& e) { Emit(Stream::kSmootherOnline, e); }) : nullptr,
+        std::move(batch)));
   }
 }
 
@@ -117,6 +133,7 @@ void Session::Impl::Emit(Stream stream, const StateEstimate& e) {
   } else {
     s.lla[0] = s.lla[1] = s.lla[2] = std::numeric_limits<double>::quiet_NaN();
   }
+  const std::lock_guard<std::mutex> lock(emit_mutex_);
   ++states_;
   if (!callback_) {
     queue_.push_back(s);
@@ -135,6 +152,7 @@ void Session::Impl::Emit(Stream stream, const StateEstimate& e) {
 }
 
 void Session::Impl::RethrowCallbackError() {
+  const std::lock_guard<std::mutex> lock(emit_mutex_);
   if (callback_error_) std::rethrow_exception(std::exchange(callback_error_, nullptr));
 }
 
@@ -145,6 +163,7 @@ bool Session::Impl::Reject(LogRecord::Type type, const std::string& reason) {
 }
 
 bool Session::Impl::Poll(State* state) {
+  const std::lock_guard<std::mutex> lock(emit_mutex_);
   if (queue_.empty()) return false;
   *state = queue_.front();
   queue_.pop_front();
@@ -167,9 +186,12 @@ Status Session::Impl::GetStatus() const {
   s.accepted = accepted_;
   s.reordered = reorder_.reordered();
   s.rejected = rejected_total_;
-  s.states = states_;
-  s.states_dropped = states_dropped_;
-  s.callback_errors = callback_errors_;
+  {
+    const std::lock_guard<std::mutex> lock(emit_mutex_);
+    s.states = states_;
+    s.states_dropped = states_dropped_;
+    s.callback_errors = callback_errors_;
+  }
   for (const auto& [key, count] : rejected_) s.rejections.push_back({"input", key.first, key.second, count});
   // Each estimator's counts (MeasurementCounts::ToJson: {"used", "rejected": {reason: n}, ...}).
   const nlohmann::json stats = session_.Stats();
@@ -188,6 +210,7 @@ Status Session::Impl::GetStatus() const {
 
 nlohmann::json Session::Impl::Stats() const {
   nlohmann::json j = session_.Stats();
+  const std::lock_guard<std::mutex> lock(emit_mutex_);
   nlohmann::json rejected = nlohmann::json::object();
   for (const auto& [key, count] : rejected_) rejected[key.first][key.second] = count;
   j["session"] = {{"accepted", accepted_},

@@ -101,8 +101,10 @@ struct Record {
 
 // --- Estimates ----------------------------------------------------------------------------------------------
 
-enum class Mode { kEskf, kSmoother, kBoth };
-const char* ModeName(Mode mode);                      // "eskf", "smoother", "both"
+// kBatch: the whole-log smoother (after the sliding window's forward pass, which it starts from); kAll:
+// the ESKF with its RTS pass, the window and the batch. The smoothed streams come at Session::Finish.
+enum class Mode { kEskf, kSmoother, kBoth, kBatch, kAll };
+const char* ModeName(Mode mode);                      // "eskf", "smoother", "both", "batch", "all"
 bool ParseMode(const std::string& name, Mode* mode);  // false for an unknown name
 
 // Which estimate a state belongs to.
@@ -111,8 +113,11 @@ enum class Stream {
   kSmoother,        // the smoother's final estimate: each keyframe when it leaves the window, then the
                     // IMU-rate states after it (delayed by the window, smoother.window_size keyframes)
   kSmootherOnline,  // the smoother's newest keyframe after each solve: causal, rougher
+  kBatch,           // the whole-log smoother: every keyframe and IMU-rate state, at Finish
+  kEskfRts,         // the ESKF smoothed by its Rauch-Tung-Striebel backward pass, at Finish
 };
-const char* StreamName(Stream stream);  // "eskf", "smoother", "smoother_online" (`gins run`'s file names)
+// "eskf", "smoother", "smoother_online", "batch", "eskf_rts" (`gins run`'s file names)
+const char* StreamName(Stream stream);
 
 struct Geodetic {
   double lat_deg = 0.0, lon_deg = 0.0, alt_m = 0.0;
@@ -200,6 +205,11 @@ struct SessionOptions {
   Mode mode = Mode::kEskf;
   bool geodetic = true;               // fill State::lla (about 0.2 µs a state)
   size_t max_queued_states = 100000;  // polling: the queue's bound
+  // With more than one estimator (kBoth, kAll): each on a thread of its own. Every stream is the same, bit
+  // for bit; the callback (or the queue) is then fed from those threads, one call at a time, each stream
+  // in its own order; status() counts the other estimators' rejections once Finish has returned. What the
+  // callback uses must outlive the Session (destroying it stops the threads).
+  bool parallel = false;
 };
 
 using StateCallback = std::function<void(const State&)>;

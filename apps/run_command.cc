@@ -114,6 +114,39 @@ nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nloh
   return input;
 }
 
+// summary.json's "faults": every fault the run met, counted in one place (the details stay where they are:
+// input.skipped, estimators.<name>.*): damaged or out-of-order lines by reason, IMU gaps, interval jitter,
+// rate changes and repeated stamps, wheel jitter and gaps, GNSS gaps, and per estimator the measurements
+// rejected, the watchdog's re-initialisations and the output states skipped as not finite.
+nlohmann::json FaultsJson(const nlohmann::json& summary, const nlohmann::json& session_stats) {
+  nlohmann::json f;
+  f["input_skipped"] = summary["input"]["skipped"];
+  f["imu_interval_jitter"] = session_stats.value("imu_interval_jitter", 0);
+  f["imu_rate_changes"] = session_stats.value("imu_rate_changes", 0);
+  f["imu_same_stamp"] = session_stats.value("imu_same_stamp", 0);
+  f["wheel_interval_jitter"] = session_stats.value("wheel_interval_jitter", 0);
+  f["wheel_gaps"] = session_stats.value("wheel_gaps", 0);
+  f["gnss_gaps"] = summary["gnss_gaps"].size();
+  f["estimators"] = nlohmann::json::object();
+  for (const auto& [name, e] : summary["estimators"].items()) {
+    nlohmann::json r = nlohmann::json::object();
+    for (const auto& [type, counts] : e.items()) {
+      if (counts.is_object() && counts.contains("rejected")) {
+        uint64_t n = 0;
+        for (const auto& [reason, c] : counts["rejected"].items()) n += c.get<uint64_t>();
+        if (n > 0) r[type] = n;
+      }
+    }
+    f["estimators"][name] = {{"imu_gaps", e.value("imu_gaps", 0)},
+                             {"rejected", r},
+                             {"watchdog_resets", e.contains("watchdog") ? e["watchdog"].value("count", 0) : 0}};
+  }
+  for (const auto& [name, o] : summary["outputs"].items()) {
+    f["non_finite_skipped"][name] = o.value("non_finite_skipped", 0);
+  }
+  return f;
+}
+
 // The summary up to the outputs: the run, its input, the estimators, timing, and the GNSS outage windows
 // (simulated ones and the log's own gaps, absolute times) that the comparison scores the drift over.
 nlohmann::json RunSummary(const Options& options, const RunRequest& request, const ReadStats& rs,
@@ -147,6 +180,7 @@ nlohmann::json RunSummary(const Options& options, const RunRequest& request, con
   j["gnss_gaps"] = session_stats["gnss_outages"]["log_gaps"];
   if (request.truth_path) j["truth"] = *request.truth_path;
   j["gnss_lever_arm_m"] = {options.gnss.lever_b.x(), options.gnss.lever_b.y(), options.gnss.lever_b.z()};
+  j["faults"] = FaultsJson(j, session_stats);
   return j;
 }
 

@@ -4,6 +4,8 @@
 // for which states an output holds.
 #pragma once
 
+#include <cmath>
+
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -52,8 +54,9 @@ std::vector<std::string> SupportedModes();
 class StateFilter {
  public:
   bool Accept(const StateEstimate& e) {
-    if (!e.x.AllFinite() || !e.sigma_p.allFinite()) {
-      ++non_finite_;
+    if (!e.x.AllFinite() || !e.sigma_p.allFinite() || !e.sigma_v.allFinite() || !e.sigma_att.allFinite() ||
+        !std::isfinite(e.odom_scale)) {
+      ++non_finite_;  // never written (the writers refuse it too): a NaN must not reach an output
       return false;
     }
     if (e.x.t <= last_t_) return false;

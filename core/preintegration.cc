@@ -34,8 +34,15 @@ void Preintegration::Integrate(const Vec3& gyro, const Vec3& acc, double dt) {
 
 void Preintegration::IntegrateGuess(const Vec3& gyro, const Vec3& acc, double dt, double held_gyro_sigma,
                                     double held_acc_sigma) {
+  IntegrateGuess(gyro, acc, dt, Vec3::Constant(held_gyro_sigma), held_acc_sigma);
+}
+
+void Preintegration::IntegrateGuess(const Vec3& gyro, const Vec3& acc, double dt, const Vec3& held_gyro_sigma,
+                                    double held_acc_sigma) {
+  // Programmer errors: the smoother coasts only forward in time (dt > 0, bounded by the reader's time limit)
+  // with σ from constants.
   CHECK(std::isfinite(dt) && dt >= 0.0) << "Preintegration::IntegrateGuess: bad dt " << dt;
-  CHECK(held_gyro_sigma >= 0.0 && held_acc_sigma >= 0.0) << "Preintegration::IntegrateGuess: bad sigma";
+  CHECK((held_gyro_sigma.array() >= 0.0).all() && held_acc_sigma >= 0.0) << "Preintegration::IntegrateGuess: bad sigma";
   if (dt == 0.0) return;
   samples_.push_back(Sample{gyro, acc, dt, held_gyro_sigma, held_acc_sigma});
   Step(samples_.back());
@@ -50,17 +57,28 @@ void Preintegration::Step(const Sample& s) {
   const Kinematics y = ImuStep(x, s.gyro - bg_lin_, s.acc - ba_lin_, Vec3::Zero(), s.dt, &J);
   // Covariance and bias Jacobians use A, B at the state before the step (as the kernel defines them).
   Mat6 Q = ImuDiscreteNoise(gyro_noise_density_, acc_noise_density_, s.dt);
-  Q.diagonal().head<3>().array() += s.held_gyro_sigma * s.held_gyro_sigma;
+  Q.diagonal().head<3>() += s.held_gyro_sigma.cwiseAbs2();
   Q.diagonal().tail<3>().array() += s.held_acc_sigma * s.held_acc_sigma;
   // The kernel's structured products (MulA, MulBG): A and B are mostly zero and identity blocks.
   const Mat9 A_cov = MulA<9>(J, cov_);
   const Eigen::Matrix<double, 9, 6> BQ = J.B.lazyProduct(Q);
   cov_ = MulA<9>(J, Mat9(A_cov.transpose())).transpose() + BQ.lazyProduct(J.B.transpose());
+  if (s.held_acc_sigma > 0.0) AddWhiteAcceleration(s.held_acc_sigma, s.dt);
   J_bias_ = MulA<6>(J, J_bias_) + J.B;
   delta_.dq = y.q;
   delta_.dv = y.v;
   delta_.dp = y.p;
   dt_total_ += s.dt;
+}
+
+void Preintegration::AddWhiteAcceleration(double sigma, double dt) {
+  // An acceleration of white noise with PSD q = σ²·dt over dt (the held part's velocity variance σ²·dt²):
+  // δv = ∫a, δp = ∫∫a, per axis [[dt³/3, dt²/2], [dt²/2, dt]]·q, isotropic so in any frame.
+  const double q = sigma * sigma * dt;
+  cov_.block<3, 3>(preint::kP, preint::kP).diagonal().array() += q * dt * dt * dt / 3.0;
+  cov_.block<3, 3>(preint::kP, preint::kV).diagonal().array() += q * dt * dt / 2.0;
+  cov_.block<3, 3>(preint::kV, preint::kP).diagonal().array() += q * dt * dt / 2.0;
+  cov_.block<3, 3>(preint::kV, preint::kV).diagonal().array() += q * dt;
 }
 
 void Preintegration::Reintegrate(const Vec3& bg_lin, const Vec3& ba_lin) {

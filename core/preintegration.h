@@ -89,8 +89,15 @@ class Preintegration {
   }
   // As Integrate, for a step whose held rate and specific force are only a guess (across an IMU gap): an
   // unknown constant error of 1-σ held_gyro_sigma (rad/s) and held_acc_sigma (m/s²) per axis, held over the
-  // step, is added to the covariance (where the held sample enters, as the bias does).
+  // step, is added to the covariance (where the held sample enters, as the bias does), and so is a white
+  // acceleration of the same σ (PSD held_acc_sigma²·dt). The held error alone moves δp and δv of one step
+  // together (δp = ½·a·dt², δv = a·dt): three directions of the 9×9 covariance would be empty, and the
+  // factor's square-root information would pin them to 1e-12 of the largest variance, so tightly that the
+  // smoother's solve stalled on them (every fix of a dropout rejected) and its covariance recovery failed.
   void IntegrateGuess(const Vec3& gyro, const Vec3& acc, double dt, double held_gyro_sigma, double held_acc_sigma);
+  // The same with the rate's σ per body axis (a vehicle's unknown turn is mostly about its vertical).
+  void IntegrateGuess(const Vec3& gyro, const Vec3& acc, double dt, const Vec3& held_gyro_sigma,
+                      double held_acc_sigma);
 
   // Re-runs the stored samples with a new linearisation point (exact, not first order). Noise densities
   // are kept.
@@ -133,11 +140,12 @@ class Preintegration {
     Vec3 gyro;
     Vec3 acc;
     double dt;
-    double held_gyro_sigma = 0.0;  // IntegrateGuess
+    Vec3 held_gyro_sigma = Vec3::Zero();  // IntegrateGuess
     double held_acc_sigma = 0.0;
   };
   void Reset();
   void Step(const Sample& s);
+  void AddWhiteAcceleration(double sigma, double dt);
 
   Vec3 bg_lin_, ba_lin_;
   double gyro_noise_density_, acc_noise_density_;

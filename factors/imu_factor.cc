@@ -35,6 +35,10 @@ ImuFactor::ImuFactor(std::shared_ptr<const Preintegration> preint, const ImuEart
 
 ImuFactor::ImuFactor(std::shared_ptr<const Preintegration> preint, const Vec3& g_w)
     : preint_(std::move(preint)), g_w_(g_w) {
+  // Programmer errors, not data: the smoother's preintegration always reaches a new keyframe's time (it
+  // coasts where no sample covers it, Smoother::IntegrateTo) and keyframes are more than kSameEpoch apart;
+  // the noise densities are checked > 0 by the config; the reader bounds time stamps (log_limits::kMaxTime),
+  // so the coasted covariance stays finite.
   CHECK(preint_ != nullptr);
   CHECK_GT(preint_->dt(), 0.0) << "ImuFactor over an empty preintegration";
   CHECK(preint_->cov().allFinite() && preint_->cov().trace() > 0.0)

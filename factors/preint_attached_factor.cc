@@ -10,7 +10,7 @@ namespace {
 using Mat9x15 = Eigen::Matrix<double, 9, 15>;
 // Rows (δp_t, δθ_t, δv_t), columns (δp_i, δθ_i, δv_i, δbg, δba).
 constexpr int kRowP = 0, kRowTheta = 3, kRowV = 6;
-constexpr int kColP = 0, kColTheta = 3, kColV = 6, kColBg = 9, kColBa = 12;
+constexpr int kColP = 0, kColTheta = 3, kColV = 6, kColBg = 9;  // δba: columns 12-14, after δbg
 
 // The prediction's Jacobian (see PreintAttachedCostFunction in the header).
 Mat9x15 PredictionJacobian(const Preintegration& pre, const ImuEarthTerms& earth, const EarthTurns& turns,

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (tests/fuzz, GINS_FUZZ=ON, Debian clang + ASan + UBSan) in build-fuzz/ and runs
 # each for a bounded time: scripts/fuzz.sh [seconds per target, default 120] [target ...].
-# Seeds: tests/fuzz/corpus/<target>/ (in the repository; the config fuzzer also starts from config/*.yaml).
+# Seeds: tests/fuzz/corpus/<target>/ (in the repository; the config fuzzer also starts from config/*.yaml; the
+# stream fuzzer's are slices of data/sample/log.txt.gz made by build-fuzz/tests/fuzz/make_stream_seeds).
 # New inputs that reach new code go to build-fuzz/corpus/<target>/ (not the repository); a crash leaves
 # build-fuzz/crash-<target>-* and makes the script fail.
 set -euo pipefail
@@ -9,7 +10,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-120}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(log_line log_reader config)
+[ ${#targets[@]} -gt 0 ] || targets=(log_line log_reader config stream)
 
 if ! command -v clang++ >/dev/null || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
   echo "gins fuzz: installing clang and libclang-rt-14-dev"
@@ -29,7 +30,8 @@ for t in "${targets[@]}"; do
   seeds=(tests/fuzz/corpus/$t)
   [ "$t" = config ] && seeds+=(config)
   echo "gins fuzz: $t for ${seconds} s"
-  # -rss_limit_mb: the reader's memory is bounded; -timeout: no input may take a second.
+  # -rss_limit_mb: the reader's memory is bounded; -timeout: no input may take two seconds (a stream input runs
+  # both estimators on at most 3000 records: well under a second).
   if ! build-fuzz/tests/fuzz/${t}_fuzzer "$corpus" "${seeds[@]}" -max_total_time="$seconds" -timeout=2 \
       -rss_limit_mb=2048 -max_len=4096 -artifact_prefix="build-fuzz/crash-$t-" -print_final_stats=1 \
       >"build-fuzz/$t.log" 2>&1; then

@@ -57,6 +57,7 @@ void Eskf::Initialize(const InitResult& init) {
     P_(eskf::kS, eskf::kS) = options_.wheel.scale_sigma * options_.wheel.scale_sigma;
   }
   last_imu_.reset();
+  last_sample_t_ = x_.t;
   gyro_sum_.setZero();
   gyro_count_ = 0;
   gyro_sum_start_ = x_.t;
@@ -75,11 +76,13 @@ void Eskf::Initialize(const InitResult& init) {
 
 void Eskf::Propagate(double t, const ImuSample* held) {
   const double dt = t - x_.t;
-  if (dt <= 0.0 || !last_imu_) return;
+  if (dt <= 0.0) return;
   if (rts_) rts_->AfterUpdates(Nominal(), P_);  // the updates at x_.t are done
-  if (held == nullptr) held = &*last_imu_;
-  // Across an IMU gap, coast: no rotation, no acceleration (the held sample says nothing about the gap).
-  const bool gap = t - last_imu_->t > options_.imu.max_gap;
+  if (held == nullptr && last_imu_) held = &*last_imu_;
+  // Across an IMU gap, coast: no rotation, no acceleration (the held sample says nothing about the gap). The
+  // gap is judged from the newest sample, whatever the state's time, and a step no sample covers (a fix
+  // after the initialisation, before the first sample) coasts too: the state always reaches t.
+  const bool gap = held == nullptr || t - last_sample_t_ > options_.imu.max_gap;
   const Vec3 g_w = gravity();
   const Vec3& rate_w = earth_.rate_w();
   const Vec3 omega = gap ? Vec3(x_.q_wb.conjugate() * rate_w) : Vec3(held->gyro - x_.bg);
@@ -87,6 +90,14 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   Kinematics k{x_.q_wb, x_.v_w, x_.p_wb};
   ImuStepJacobians J;
   k = ImuStep(k, omega, acc, g_w, dt, &J, rate_w);
+  if (gap) {
+    // The coast's transition (CoastCovariance): its errors depend on neither the attitude nor the biases.
+    J.A.block<3, 3>(0, 6).setZero();
+    J.A.block<3, 3>(3, 6).setZero();
+    J.A.block<3, 3>(6, 6).setIdentity();
+    J.B.setZero();
+    J.G.setZero();
+  }
   if (rts_) rts_->Step(J, omega + x_.bg, acc + x_.ba, x_.t, dt);
   a_w_ = (k.v - x_.v_w) / dt;
   x_.q_wb = k.q;
@@ -94,10 +105,36 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   x_.p_wb = k.p;
   x_.t = t;
   ++imu_steps_;
-  PropagateCovariance(J, dt, gap);
+  if (gap) {
+    CoastCovariance(dt);
+  } else {
+    PropagateCovariance(J, dt);
+  }
 }
 
-void Eskf::PropagateCovariance(const ImuStepJacobians& J, double dt, bool gap) {
+void Eskf::CoastCovariance(double dt) {
+  // The coast's mean is a constant velocity and attitude, made without the sensor, so its errors do not
+  // depend on the attitude's or the biases' (the kernel's Jacobians would say they do: a tilt would then be
+  // read into the velocity, and a returning fix's innovation back into the tilt). F = [[I, I·dt, 0],
+  // [0, I, 0], [0, 0, I]] on (δp, δv, δθ), identity elsewhere.
+  P_.middleRows<3>(nav::kP) += dt * P_.middleRows<3>(nav::kV);  // F·P
+  P_.middleCols<3>(nav::kP) += dt * P_.middleCols<3>(nav::kV);  // (F·P)·Fᵀ
+  // The unknown motion as random walks, so a gap cut into steps (by the fixes inside it) grows the same
+  // uncertainty as one step: a white acceleration in w, and a rotation mostly about the vertical (a car's
+  // roll and pitch change only with the road's grade and banking).
+  const double qa = kImuGapAccDensity * kImuGapAccDensity;
+  P_.block<3, 3>(nav::kP, nav::kP).diagonal().array() += qa * dt * dt * dt / 3.0;
+  P_.block<3, 3>(nav::kP, nav::kV).diagonal().array() += qa * dt * dt / 2.0;
+  P_.block<3, 3>(nav::kV, nav::kP).diagonal().array() += qa * dt * dt / 2.0;
+  P_.block<3, 3>(nav::kV, nav::kV).diagonal().array() += qa * dt;
+  const Vec3 q_w(kImuGapTiltDensity * kImuGapTiltDensity, kImuGapTiltDensity * kImuGapTiltDensity,
+                 kImuGapYawDensity * kImuGapYawDensity);
+  const Mat3 R_bw = x_.R_wb().transpose();  // δθ is about the body axes
+  P_.block<3, 3>(nav::kTheta, nav::kTheta) += R_bw * (q_w * dt).asDiagonal() * R_bw.transpose();
+  AddRandomWalks(dt);
+}
+
+void Eskf::PropagateCovariance(const ImuStepJacobians& J, double dt) {
   // F = [[A, C], [0, I]] with the kinematic block a = (δp, δv, δθ) and b = (δbg, δba, δg, δs), C = [B G 0]:
   // P'aa = A·Paa·Aᵀ + A·Pab·Cᵀ + C·Pba·Aᵀ + C·Pbb·Cᵀ = (A·M1ᵀ + C·Mᵀ)ᵀ with M1 = A·Paa + C·Pba and
   // M = P'ab = A·Pab + C·Pbb. The products skip A's and C's zero and identity blocks (MulA, MulBG). C has
@@ -118,13 +155,7 @@ void Eskf::PropagateCovariance(const ImuStepJacobians& J, double dt, bool gap) {
   P_.bottomLeftCorner<kB, kA>() = M.transpose();
 
   // Process noise: sensor white noise through B, bias and scale random walks.
-  Mat6 Qn = ImuDiscreteNoise(options_.imu.gyro_noise_density, options_.imu.acc_noise_density, dt);
-  if (gap) {
-    // An unknown rate and acceleration held over the step enter where the held sample does.
-    Qn.diagonal() += (Vec6() << Vec3::Constant(kImuGapRateSigma * kImuGapRateSigma),
-                      Vec3::Constant(kImuGapAccSigma * kImuGapAccSigma))
-                         .finished();
-  }
+  const Mat6 Qn = ImuDiscreteNoise(options_.imu.gyro_noise_density, options_.imu.acc_noise_density, dt);
   const Eigen::Matrix<double, kA, 6> BQ = J.B.lazyProduct(Qn);
   P_.topLeftCorner<kA, kA>() += BQ.lazyProduct(J.B.transpose());
   AddRandomWalks(dt);
@@ -143,14 +174,13 @@ void Eskf::AddRandomWalks(double dt) {
 void Eskf::AddImu(const ImuSample& imu) {
   if (!initialized_) return;
   if (imu.t < x_.t) return;  // samples before the initialisation epoch were used by the initialiser
-  if (last_imu_ && imu.t - last_imu_->t > options_.imu.max_gap) {
-    imu_gaps_.Add(last_imu_->t, imu.t);
-  }
-  if (last_imu_) {
-    const ImuSample mid = HeldBetween(*last_imu_, imu);
-    Propagate(imu.t, &mid);
-  }
+  // Before the first sample after the initialisation, its epoch is the newest sample (a dropout right after
+  // it is a gap as any other).
+  if (imu.t - last_sample_t_ > options_.imu.max_gap) imu_gaps_.Add(last_sample_t_, imu.t);
+  const ImuSample mid = last_imu_ ? HeldBetween(*last_imu_, imu) : imu;
+  Propagate(imu.t, &mid);
   last_imu_ = imu;
+  last_sample_t_ = imu.t;
   gyro_sum_ += imu.gyro;
   ++gyro_count_;
   wheel_gyro_sum_ += imu.gyro;

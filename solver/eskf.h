@@ -81,7 +81,9 @@ class Eskf : public Estimator {
   // (default: the last IMU sample).
   void Propagate(double t, const ImuSample* held = nullptr);
   // P through one kernel step (J) of dt; gap: the step coasted over an IMU gap.
-  void PropagateCovariance(const ImuStepJacobians& J, double dt, bool gap);
+  void PropagateCovariance(const ImuStepJacobians& J, double dt);
+  // The covariance over a step no IMU sample covers (an IMU gap): see kImuGapAccDensity.
+  void CoastCovariance(double dt);
   // The random walks of the driving and passive blocks over dt.
   void AddRandomWalks(double dt);
   // A measurement model linearised at the filter's current nominal state: its residual r = h(x) − z and
@@ -129,6 +131,7 @@ class Eskf : public Estimator {
   double scale_ = 1.0;
   MatP P_ = MatP::Identity();
   std::optional<ImuSample> last_imu_;
+  double last_sample_t_ = 0.0;  // the newest sample's time; the initialisation's epoch before the first one
   Vec3 a_w_ = Vec3::Zero();  // acceleration in w over the last IMU step
   // Gyro readings since the last standstill update, for the zero-rate update.
   Vec3 gyro_sum_ = Vec3::Zero();

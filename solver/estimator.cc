@@ -26,6 +26,8 @@ bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeas
     x->v_w = (m.p_w - prev_fix->p_w) / (m.t - prev_fix->t);
     have_velocity = true;
   }
+  // A kept velocity keeps the σ it had (a long coast's is large), at least kResetKeptVelSigma.
+  const double kept_sigma_v = std::sqrt(P.block<3, 3>(nav::kV, nav::kV).diagonal().maxCoeff());
   for (int k : {nav::kP, nav::kV}) {
     P.middleRows(k, 3).setZero();
     P.middleCols(k, 3).setZero();
@@ -34,8 +36,20 @@ bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeas
   const double cap = 0.25 * options.watchdog.max_position_sigma;
   const double sigma_p = std::min(kResetPosSigma, cap);
   P.block<3, 3>(nav::kP, nav::kP).diagonal() = m.sigma_w.cwiseAbs2() + Vec3::Constant(sigma_p * sigma_p);
-  const double sigma_v = std::min(have_velocity ? kResetVelSigma : kResetKeptVelSigma, cap);
+  const double sigma_v =
+      std::min(have_velocity ? kResetVelSigma : std::max(kResetKeptVelSigma, std::isfinite(kept_sigma_v) ? kept_sigma_v : 0.0), cap);
   P.block<3, 3>(nav::kV, nav::kV).diagonal().setConstant(sigma_v * sigma_v);
+  // A vehicle's attitude is known at least as well as the fallback's (level within 0.22 rad, yaw within
+  // 1 rad): a larger attitude σ (a long coast's) is reset to that, decorrelated from the rest, so the next
+  // fixes are not read as tilt.
+  const Mat3 fallback = FallbackCovariance(options).block<3, 3>(nav::kTheta, nav::kTheta);
+  const Vec3 att_var = P.block<3, 3>(nav::kTheta, nav::kTheta).diagonal();
+  if (!(att_var.array() <= fallback.diagonal().array()).all()) {
+    const Vec3 capped = att_var.cwiseMin(fallback.diagonal());
+    P.middleRows(nav::kTheta, 3).setZero();
+    P.middleCols(nav::kTheta, 3).setZero();
+    P.block<3, 3>(nav::kTheta, nav::kTheta).diagonal() = capped.array().isFinite().select(capped, fallback.diagonal());
+  }
   const Vec3 z_b = x->q_wb.conjugate() * Vec3::UnitZ();
   const double yaw_var = z_b.dot(P.block<3, 3>(nav::kTheta, nav::kTheta) * z_b);
   const double min_yaw_var = kResetMinYawSigma * kResetMinYawSigma;

@@ -103,9 +103,14 @@ class ImuGapLog {
 };
 
 // Across an IMU gap longer than imu.max_gap_s both estimators coast (no rotation, no acceleration) with the
-// uncertainty of an unknown acceleration and rotation rate held over the gap.
-constexpr double kImuGapAccSigma = 2.0;                // m/s²
-constexpr double kImuGapRateSigma = 10.0 * kDegToRad;  // rad/s
+// uncertainty of an unknown motion (Eskf::CoastCovariance, Smoother::IntegrateTo), taken as random walks so
+// that a gap cut into steps (by the fixes inside it) grows as much as one step; their σ grow with the square
+// root of the gap: the velocity's by 2 m/s in 1 s (6 m/s in 10 s, 15 m/s in 60 s: a car's speed changes),
+// the yaw's by 10° in 1 s (77° in 60 s: it may turn any way), roll and pitch by 0.5° in 1 s (4° in 60 s: a
+// road's grade and banking).
+constexpr double kImuGapAccDensity = 2.0;                 // m/s² per √(1/s): σ_v = 2 m/s·√(T/1 s)
+constexpr double kImuGapYawDensity = 10.0 * kDegToRad;    // rad per √s
+constexpr double kImuGapTiltDensity = 0.5 * kDegToRad;    // rad per √s
 
 // A standstill detection is ignored while the estimate moves faster than standstill.max_speed_m_s: a quiet
 // IMU at constant speed is not a stop.

@@ -155,8 +155,40 @@ void Session::EnsureInitializer() {
   pending_wheel_ = {};
 }
 
+void Session::WatchImuInterval(double t) {
+  constexpr int kRunForRateChange = 10;
+  const std::optional<double> last = last_imu_t_;
+  last_imu_t_ = t;
+  if (!last) return;
+  const double dt = t - *last;
+  if (!(dt > 0.0)) {
+    ++imu_same_stamp_;
+    return;
+  }
+  if (dt > options_.imu.max_gap) return;  // a gap: the estimators count it
+  const auto near = [](double a, double b) { return std::abs(a - b) <= 0.1 * b; };
+  if (imu_nominal_dt_ <= 0.0 || near(dt, imu_nominal_dt_)) {
+    if (imu_nominal_dt_ <= 0.0) imu_nominal_dt_ = dt;
+    imu_candidate_runs_ = 0;
+    return;
+  }
+  ++imu_jitter_;
+  if (imu_candidate_runs_ > 0 && near(dt, imu_candidate_dt_)) {
+    if (++imu_candidate_runs_ >= kRunForRateChange) {
+      ++imu_rate_changes_;
+      imu_jitter_ -= static_cast<uint64_t>(imu_candidate_runs_);  // the new rate's samples, not jitter
+      imu_nominal_dt_ = imu_candidate_dt_;
+      imu_candidate_runs_ = 0;
+    }
+  } else {
+    imu_candidate_dt_ = dt;
+    imu_candidate_runs_ = 1;
+  }
+}
+
 void Session::AddImu(const ImuSample& raw) {
   Touch(raw.t);
+  WatchImuInterval(raw.t);
   ImuSample s = raw;
   s.gyro = options_.imu.R_b_imu * raw.gyro;
   s.acc = options_.imu.R_b_imu * raw.acc;
@@ -328,6 +360,9 @@ nlohmann::json Session::Stats() const {
   nlohmann::json j;
   j["odom_ignored_wheel_disabled"] = odom_ignored_;
   j["gvel_unused"] = gvel_unused_;
+  j["imu_interval_jitter"] = imu_jitter_;
+  j["imu_rate_changes"] = imu_rate_changes_;
+  j["imu_same_stamp"] = imu_same_stamp_;
   j["wheel_interval_jitter"] = wheel_jitter_;
   j["wheel_gaps"] = wheel_gaps_;
   j["dropped_before_first_fix"] = pending_dropped_;

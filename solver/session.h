@@ -103,6 +103,14 @@ class Session {
   std::optional<double> last_odom_t_;
   uint64_t wheel_jitter_ = 0, wheel_gaps_ = 0;
   double first_t_ = -1.0, last_t_ = 0.0;
+  // IMU sample spacing, for the summary (the estimators integrate each interval as stamped, and count the
+  // gaps): an interval more than 10 % off the nominal one is jitter; ten in a row that agree on a new
+  // interval are a rate change, which becomes the nominal.
+  void WatchImuInterval(double t);
+  std::optional<double> last_imu_t_;
+  double imu_nominal_dt_ = 0.0, imu_candidate_dt_ = 0.0;
+  int imu_candidate_runs_ = 0;
+  uint64_t imu_jitter_ = 0, imu_rate_changes_ = 0, imu_same_stamp_ = 0;
 
   // Standstill detection (core/standstill_detector.h), fed from the initialiser's start; after
   // initialisation a StandstillMeasurement goes to every estimator every 0.1 s while the vehicle stands.

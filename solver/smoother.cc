@@ -90,6 +90,7 @@ void Smoother::Initialize(const InitResult& init) {
                                              options_.imu.acc_noise_density);
   interval_samples_.clear();
   last_imu_.reset();
+  last_sample_t_ = init.x0.t;
   t_now_ = init.x0.t;
   pred_ = init.x0;
   initialized_ = true;
@@ -100,28 +101,31 @@ void Smoother::Initialize(const InitResult& init) {
 void Smoother::IntegrateTo(double t, const ImuSample* held) {
   const double dt = t - t_now_;
   if (dt <= 0.0) return;
-  if (last_imu_) {
-    if (held == nullptr) held = &*last_imu_;
-    ImuSample coast;
-    if (t - last_imu_->t > options_.imu.max_gap) {
-      // Across an IMU gap: no rotation and no acceleration, from the current estimate, with the
-      // uncertainty of an unknown rate and acceleration held over the gap.
-      coast.t = held->t;
-      coast.gyro = pred_.bg + pred_.q_wb.conjugate() * earth_.rate_w();
-      coast.acc = pred_.q_wb.conjugate() * (2.0 * earth_.rate_w().cross(pred_.v_w) - g_w_) + pred_.ba;
-      held = &coast;
-      preint_->IntegrateGuess(coast.gyro, coast.acc, dt, kImuGapRateSigma, kImuGapAccSigma);
-    } else {
-      preint_->Integrate(*held, dt);
-    }
-    interval_samples_.push_back({*held, dt});
-    Kinematics k{pred_.q_wb, pred_.v_w, pred_.p_wb};
-    k = ImuStep(k, held->gyro - pred_.bg, held->acc - pred_.ba, g_w_, dt, nullptr, earth_.rate_w());
-    pred_.q_wb = k.q;
-    pred_.v_w = k.v;
-    pred_.p_wb = k.p;
-    g_w_ = earth_.Gravity(pred_.p_wb);
+  if (held == nullptr && last_imu_) held = &*last_imu_;
+  ImuSample coast;
+  // Across an IMU gap (judged from the newest sample, whatever t_now_ is), and over a step no sample covers
+  // (a fix after the initialisation, before the first sample): no rotation and no acceleration, from the
+  // current estimate, with the uncertainty of an unknown rate and acceleration held over the gap. So the
+  // preintegration always reaches t, and no keyframe is made over an empty one.
+  if (held == nullptr || t - last_sample_t_ > options_.imu.max_gap) {
+    coast.t = t_now_;
+    coast.gyro = pred_.bg + pred_.q_wb.conjugate() * earth_.rate_w();
+    coast.acc = pred_.q_wb.conjugate() * (2.0 * earth_.rate_w().cross(pred_.v_w) - g_w_) + pred_.ba;
+    held = &coast;
+    // The unknown motion as random walks (kImuGapAccDensity): held over dt, σ = density/√dt.
+    const double root_dt = std::sqrt(dt);
+    const Vec3 rate_sigma = Vec3(kImuGapTiltDensity, kImuGapTiltDensity, kImuGapYawDensity) / root_dt;
+    preint_->IntegrateGuess(coast.gyro, coast.acc, dt, rate_sigma, kImuGapAccDensity / root_dt);
+  } else {
+    preint_->Integrate(*held, dt);
   }
+  interval_samples_.push_back({*held, dt});
+  Kinematics k{pred_.q_wb, pred_.v_w, pred_.p_wb};
+  k = ImuStep(k, held->gyro - pred_.bg, held->acc - pred_.ba, g_w_, dt, nullptr, earth_.rate_w());
+  pred_.q_wb = k.q;
+  pred_.v_w = k.v;
+  pred_.p_wb = k.p;
+  g_w_ = earth_.Gravity(pred_.p_wb);
   pred_.t = t;
   t_now_ = t;
 }
@@ -130,14 +134,13 @@ void Smoother::AddImu(const ImuSample& imu) {
   if (!initialized_ || imu.t < t_now_) return;
   // The measurements of the last epoch are all in: solve before the IMU moves on from it.
   SolveIfPending();
-  if (last_imu_ && imu.t - last_imu_->t > options_.imu.max_gap) {
-    imu_gaps_.Add(last_imu_->t, imu.t);
-  }
-  if (last_imu_) {
-    const ImuSample mid = HeldBetween(*last_imu_, imu);
-    IntegrateTo(imu.t, &mid);
-  }
+  // Before the first sample after the initialisation, its epoch is the newest sample (a dropout right after
+  // it is a gap as any other).
+  if (imu.t - last_sample_t_ > options_.imu.max_gap) imu_gaps_.Add(last_sample_t_, imu.t);
+  const ImuSample mid = last_imu_ ? HeldBetween(*last_imu_, imu) : imu;
+  IntegrateTo(imu.t, &mid);
   last_imu_ = imu;
+  last_sample_t_ = imu.t;
   // Without GNSS a keyframe still comes every max_keyframe_interval, so no preintegration spans an outage.
   // The 10 % grace lets a fix due at that very epoch (often logged just after the IMU sample) make the
   // keyframe itself, instead of a second solve at the same time.
@@ -282,8 +285,13 @@ void Smoother::AddGnss(const GnssMeasurement& m) {
   if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
   if (options_.watchdog.enabled) {
     const double max_sigma = options_.watchdog.max_position_sigma;
-    const bool finite = window_.back().State().AllFinite() && pred_.AllFinite();
-    if (!finite || last_sigma_p_ > max_sigma) {
+    // The σ at the fix, predicted from the newest keyframe (the σ of the keyframe that left the window last,
+    // a window behind, lags a long gap by a window's time).
+    const Prediction p = PredictAt(m.t);
+    const Mat15 P = NavCovariance(window_.EstimatedTypes(), p.cov);
+    const double sigma_p = std::sqrt(P.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
+    const bool finite = window_.back().State().AllFinite() && pred_.AllFinite() && std::isfinite(sigma_p);
+    if (!finite || last_sigma_p_ > max_sigma || sigma_p > max_sigma) {
       ResetFromGnss(m, finite ? "covariance" : "non_finite");
       prev_fix_ = m;
       return;
@@ -338,8 +346,10 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
   // The chain the whole-log smoother sees ends at the newest keyframe, with the IMU steps after it.
   if (factor_log_ && finite) factor_log_->SetTail(&window_.back(), interval_samples_);
   const std::optional<ImuSample> last_imu = last_imu_;
+  const double last_sample_t = last_sample_t_;
   Initialize(init);  // a fresh problem and window; emits the new keyframe on the online stream
   last_imu_ = last_imu;
+  last_sample_t_ = last_sample_t;
   for (auto& attacher : attachers_) attacher->OnWindowRebuilt();
   last_sigma_p_ = 0.0;
   reset_reason_.clear();

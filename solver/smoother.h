@@ -105,6 +105,7 @@ class Smoother : public Estimator {
   std::shared_ptr<Preintegration> preint_;
   std::vector<HeldImuSample> interval_samples_;
   std::optional<ImuSample> last_imu_;
+  double last_sample_t_ = 0.0;  // the newest sample's time; the initialisation's epoch before the first one
   double t_now_ = 0.0;
   NavState pred_;  // IMU-propagated from the newest keyframe, for initial values
   double initial_scale_ = 1.0;  // odometer scale of the first keyframe (kept across a watchdog reset)

@@ -2,6 +2,10 @@
 
 #include <ceres/crs_matrix.h>
 
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -22,6 +26,67 @@ StateEstimate EstimateOf(const Keyframe& kf, const Mat15* cov) {
   return e;
 }
 
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double>;
+
+// Columns `columns` of H⁻¹ (H the window's information, JᵀJ). The sparse LDLᵀ first (the common case, bit for
+// bit as before); it is accepted only with every pivot positive and every variance it gives positive and
+// finite. A window whose coasted interval (an IMU gap, a long outage) makes H ill-conditioned can give a
+// factorisation that "succeeds" with non-positive pivots (negative variances, NaN σ): then the same on H
+// scaled to unit diagonal, and failing that (numerically singular) its eigen-decomposition with eigenvalues
+// floored at 1e-12 of the largest (a direction the data do not constrain gets a large, finite variance).
+// False only when H is not finite.
+bool InverseColumns(const SpMat& H, const std::vector<int>& columns, MatX* C) {
+  const int m = static_cast<int>(columns.size());
+  MatX E = MatX::Zero(H.rows(), m);
+  for (int k = 0; k < m; ++k) E(columns[k], k) = 1.0;
+  const auto usable = [&](const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>>& ldlt) {
+    return ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > 0.0).all();
+  };
+  const auto positive = [&](const MatX& c) {
+    if (!c.allFinite()) return false;
+    for (int k = 0; k < m; ++k) {
+      if (!(c(columns[k], k) > 0.0)) return false;
+    }
+    return true;
+  };
+  {
+    const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(H);
+    if (usable(ldlt)) {
+      *C = ldlt.solve(E);
+      if (ldlt.info() == Eigen::Success && positive(*C)) return true;
+    }
+  }
+  // Scaled to unit diagonal (the coasted interval's information is orders of magnitude below the rest).
+  VecX s = VecX::Ones(H.rows());
+  for (int i = 0; i < H.rows(); ++i) {
+    const double d = H.coeff(i, i);
+    if (d > 0.0 && std::isfinite(d)) s[i] = 1.0 / std::sqrt(d);
+  }
+  const SpMat Hs = s.asDiagonal() * H * s.asDiagonal();
+  {
+    const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(Hs);
+    if (usable(ldlt)) {
+      *C = s.asDiagonal() * ldlt.solve(MatX(s.asDiagonal() * E));
+      if (ldlt.info() == Eigen::Success && positive(*C)) return true;
+    }
+  }
+  // Numerically singular: the eigen-decomposition, eigenvalues floored.
+  MatX Hd = Hs.toDense();
+  if (!Hd.allFinite()) return false;
+  Hd = 0.5 * (Hd + Hd.transpose()).eval();
+  const Eigen::SelfAdjointEigenSolver<MatX> es(Hd);
+  if (es.info() != Eigen::Success) return false;
+  const double floor = std::max(1e-12 * es.eigenvalues().maxCoeff(), 1e-300);
+  const VecX inv = es.eigenvalues().cwiseMax(floor).cwiseInverse();
+  const MatX Es = es.eigenvectors().transpose() * (s.asDiagonal() * E);
+  *C = s.asDiagonal() * (es.eigenvectors() * (inv.asDiagonal() * Es));
+  return C->allFinite();
+}
+
+}  // namespace
+
 // The window is a chain, so H is banded: a sparse product and a sparse LDLᵀ in the natural (time) order
 // cost a few hundred µs where dense ones cost milliseconds per keyframe.
 bool LeadingCovariance(ceres::Problem* problem, const std::vector<double*>& blocks, const std::vector<int>& nav_index,
@@ -37,17 +102,12 @@ bool LeadingCovariance(ceres::Problem* problem, const std::vector<double*>& bloc
     if (nav_index[i] >= 0) columns.push_back(i);
   }
   const int m = static_cast<int>(columns.size());
-  using SpMat = Eigen::SparseMatrix<double>;
   const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor, int>> Js(
       J.num_rows, J.num_cols, static_cast<Eigen::Index>(J.values.size()), J.rows.data(), J.cols.data(),
       J.values.data());
   const SpMat H = SpMat(Js.transpose()) * Js;
-  const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(H);
-  if (ldlt.info() != Eigen::Success) return false;
-  MatX E = MatX::Zero(H.rows(), m);
-  for (int k = 0; k < m; ++k) E(columns[k], k) = 1.0;
-  const MatX C = ldlt.solve(E);
-  if (ldlt.info() != Eigen::Success) return false;
+  MatX C;
+  if (!InverseColumns(H, columns, &C)) return false;
   for (int i = 0; i < m; ++i) {
     for (int j = 0; j < m; ++j) (*cov)(nav_index[columns[i]], nav_index[columns[j]]) = C(columns[i], j);
   }
@@ -62,22 +122,17 @@ bool KeyframesCovariance(KeyframeStore& store, const std::vector<size_t>& keyfra
   int per_keyframe = 0;
   for (BlockType t : store.EstimatedTypes()) per_keyframe += SpecOf(t).tangent_size;
   if (J.num_cols != per_keyframe * static_cast<int>(store.size())) return false;
-  using SpMat = Eigen::SparseMatrix<double>;
   const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor, int>> Js(
       J.num_rows, J.num_cols, static_cast<Eigen::Index>(J.values.size()), J.rows.data(), J.cols.data(),
       J.values.data());
   const SpMat H = SpMat(Js.transpose()) * Js;
-  const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(H);
-  if (ldlt.info() != Eigen::Success) return false;
   std::vector<int> columns;
   for (size_t k : keyframes) {
     for (int i = 0; i < per_keyframe; ++i) columns.push_back(static_cast<int>(k) * per_keyframe + i);
   }
   const int m = static_cast<int>(columns.size());
-  MatX E = MatX::Zero(H.rows(), m);
-  for (int i = 0; i < m; ++i) E(columns[i], i) = 1.0;
-  const MatX C = ldlt.solve(E);
-  if (ldlt.info() != Eigen::Success) return false;
+  MatX C;
+  if (!InverseColumns(H, columns, &C)) return false;
   cov->resize(m, m);
   for (int i = 0; i < m; ++i) {
     for (int j = 0; j < m; ++j) (*cov)(i, j) = C(columns[i], j);

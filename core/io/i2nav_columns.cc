@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "core/io/log_reader.h"
+
 namespace gins {
 namespace {
 
@@ -126,6 +128,10 @@ const char* ColumnReader::Parse(std::string_view text, Columns* c, bool* blank, 
 const char* ColumnReader::CheckOrder(const Columns& c, std::string* detail) const {
   if (c.t < 0.0L) {
     *detail = FormatText("column 1 (t) = %.6f, time must be >= 0", c.v[0]);
+    return kAbsurdValue;
+  }
+  if (c.t >= static_cast<long double>(log_limits::kMaxTime)) {  // gins's reader would refuse it
+    *detail = FormatText("column 1 (t) = %.6f, beyond %g s", c.v[0], log_limits::kMaxTime);
     return kAbsurdValue;
   }
   if (!have_last_ || c.t > last_t_) return nullptr;

@@ -204,6 +204,10 @@ LineParse CheckFieldCount(LogRecord::Type type, const char* const* names, size_t
 // records pushed through the API.
 LineParse CheckValues(LogRecord::Type type, size_t n, const double* v, InputIssue* issue) {
   if (!(v[0] > 0.0)) return Damaged(issue, kAbsurdValue, FieldValue(0, "t", v[0]) + ", time must be > 0");
+  if (!(v[0] < log_limits::kMaxTime)) {
+    return Damaged(issue, kAbsurdValue,
+                   FieldValue(0, "t", v[0]) + " s, beyond " + Num(log_limits::kMaxTime) + " s (not seconds?)");
+  }
   std::string absurd;
   switch (type) {
     case LogRecord::Type::kImu:

@@ -58,6 +58,10 @@ inline constexpr double kMaxSigma = 1e4;            // m, exclusive; σ must als
 inline constexpr double kMaxAbsHeadingDeg = 360.0;  // inclusive; normalised into [0, 360)
 inline constexpr double kMaxAbsPulses = 1e7;        // exclusive
 inline constexpr double kMaxAbsSpeed = 1000.0;      // m/s, per axis of a GNSS velocity, inclusive
+// Time stamps are seconds in (0, kMaxTime): 1e10 s is the year 2286 as Unix time, so a larger stamp is not in
+// seconds (milliseconds or nanoseconds since the epoch) or is corrupted. The bound also keeps every interval
+// between two records, and the fourth power of it that a coasted covariance takes, finite.
+inline constexpr double kMaxTime = 1e10;            // s, exclusive
 }  // namespace log_limits
 
 struct LogRecord {

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -11,8 +12,14 @@
 namespace gins {
 namespace {
 
+// The longest field: a finite double in fixed notation with up to 9 decimals ("-", 309 digits, ".", 9), or in
+// scientific notation; and the longest line, the state CSV's 27 fields with their separators.
+constexpr size_t kMaxField = 1 + 309 + 1 + 9;
+constexpr size_t kMaxFields = 27;
+
 // Builds one output line with the fast formatters of core/number_format.h: printf, then std::to_chars,
-// dominated the ESKF's run time at IMU rate.
+// dominated the ESKF's run time at IMU rate. Sized for the longest line of finite values, so no field is ever
+// cut (the buffer is not initialised: its size costs nothing).
 class Line {
  public:
   Line& Fixed(double v, int precision) {
@@ -30,7 +37,7 @@ class Line {
   void WriteTo(FILE* f) { std::fwrite(buf_, 1, static_cast<size_t>(pos_ - buf_), f); }
 
  private:
-  char buf_[1024];
+  char buf_[kMaxFields * (kMaxField + 1)];
   char* pos_ = buf_;
   char* end_ = buf_ + sizeof(buf_);
 };
@@ -79,18 +86,21 @@ const char kStatesCsvColumns[] =
     "t,px,py,pz,vx,vy,vz,qw,qx,qy,qz,bgx,bgy,bgz,bax,bay,baz,"
     "sigma_px,sigma_py,sigma_pz,sigma_vx,sigma_vy,sigma_vz,sigma_att_e,sigma_att_n,sigma_att_u,odom_scale\n";
 
-void WriteTumLine(FILE* f, const NavState& x) {
+bool WriteTumLine(FILE* f, const NavState& x) {
+  if (!x.AllFinite()) return false;
   Line l;
   l.Fixed(x.t, 6);
   for (int i = 0; i < 3; ++i) l.Char(' ').Fixed(x.p_wb[i], 5);
   l.Char(' ').Fixed(x.q_wb.x(), 9).Char(' ').Fixed(x.q_wb.y(), 9).Char(' ').Fixed(x.q_wb.z(), 9);
   l.Char(' ').Fixed(x.q_wb.w(), 9).Char('\n');
   l.WriteTo(f);
+  return true;
 }
 
-void TumWriter::Add(const NavState& x) {
-  WriteTumLine(file_.stream(), x);
+bool TumWriter::Add(const NavState& x) {
+  if (!WriteTumLine(file_.stream(), x)) return false;
   ++count_;
+  return true;
 }
 
 StatesCsvWriter::StatesCsvWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin)
@@ -99,12 +109,15 @@ StatesCsvWriter::StatesCsvWriter(const std::string& path, const std::string& mod
   file_.Write(kStatesCsvColumns);
 }
 
-void StatesCsvWriter::Add(const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa, double odom_scale) {
-  WriteStatesCsvLine(file_.stream(), x, sp, sv, sa, odom_scale);
+bool StatesCsvWriter::Add(const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa, double odom_scale) {
+  return WriteStatesCsvLine(file_.stream(), x, sp, sv, sa, odom_scale);
 }
 
-void WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa,
+bool WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa,
                         double odom_scale) {
+  if (!x.AllFinite() || !sp.allFinite() || !sv.allFinite() || !sa.allFinite() || !std::isfinite(odom_scale)) {
+    return false;
+  }
   Line l;
   l.Fixed(x.t, 6);
   for (int i = 0; i < 3; ++i) l.Char(',').Fixed(x.p_wb[i], 5);
@@ -116,6 +129,7 @@ void WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sp, const Vec3& 
   }
   l.Char(',').Fixed(odom_scale, 6).Char('\n');
   l.WriteTo(f);
+  return true;
 }
 
 }  // namespace gins

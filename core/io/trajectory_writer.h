@@ -33,9 +33,11 @@ class AtomicFile {
 std::string TrajectoryHeader(const std::string& mode, const GeodeticPoint& origin);
 
 // One line of each format (with its '\n') to any stream: the writers below and `gins stream`'s stdout
-// print the same bytes.
-void WriteTumLine(FILE* f, const NavState& x);
-void WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att,
+// print the same bytes. Nothing is ever written with a number that is not finite: such a state is refused
+// whole (false, nothing written), so a NaN cannot reach an output whatever the caller checked. Any finite
+// value fits its line, however large.
+bool WriteTumLine(FILE* f, const NavState& x);
+bool WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att,
                         double odom_scale);
 // The states CSV's column header line (after the TrajectoryHeader comment).
 extern const char kStatesCsvColumns[];
@@ -44,7 +46,7 @@ extern const char kStatesCsvColumns[];
 class TumWriter {
  public:
   TumWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin);
-  void Add(const NavState& x);
+  bool Add(const NavState& x);
   void Commit() { file_.Commit(); }
   uint64_t count() const { return count_; }
 
@@ -57,7 +59,7 @@ class TumWriter {
 class StatesCsvWriter {
  public:
   StatesCsvWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin);
-  void Add(const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att, double odom_scale);
+  bool Add(const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att, double odom_scale);
   void Commit() { file_.Commit(); }
 
  private:

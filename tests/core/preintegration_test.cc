@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
+#include <string>
 #include <random>
 #include <vector>
 
@@ -280,6 +283,31 @@ TEST(PredictedCovarianceTest, EqualsStepwisePropagation) {
   // And the predicted mean is the kernel's.
   const NavState x_j = pre.Predict(x_i, g);
   EXPECT_LT((x_j.p_wb - k.p).norm(), 1e-9);
+}
+
+// A guessed step across an IMU gap (IntegrateGuess) has a full-rank covariance: the held error alone moves δp
+// and δv together, leaving three empty directions that a factor's square-root information would pin. Its
+// velocity variance is the held error's plus the white part's, 2·σ²·dt² per axis, and a gap of one step or of
+// several steps alike leaves every eigenvalue far above the 1e-12 floor.
+TEST(Preintegration, GuessedStepAcrossAGapHasAFullRankCovariance) {
+  const double sigma_a = 2.0, sigma_g = 0.17;
+  for (int steps : {1, 3}) {
+    for (double dt : {0.6, 1.0, 30.0}) {
+      SCOPED_TRACE("steps " + std::to_string(steps) + ", dt " + std::to_string(dt));
+      Preintegration p(Vec3::Zero(), Vec3::Zero(), 2e-4, 1e-3);
+      for (int k = 0; k < steps; ++k) p.IntegrateGuess(Vec3::Zero(), Vec3(0.0, 0.0, kG), dt / steps, sigma_g, sigma_a);
+      const Eigen::SelfAdjointEigenSolver<Mat9> es(p.cov());
+      const Vec9 lambda = es.eigenvalues();
+      EXPECT_GT(lambda.minCoeff(), 1e-9 * lambda.maxCoeff()) << lambda.transpose();
+      if (steps == 1) {
+        EXPECT_NEAR(p.cov()(preint::kV, preint::kV), 2.0 * sigma_a * sigma_a * dt * dt, 1e-5 * dt * dt);
+      }
+    }
+  }
+  // An ordinary step keeps the sensor's own model (no white part added).
+  Preintegration q(Vec3::Zero(), Vec3::Zero(), 2e-4, 1e-3);
+  q.Integrate(Vec3::Zero(), Vec3(0.0, 0.0, kG), 0.01);
+  EXPECT_NEAR(q.cov()(preint::kV, preint::kV), 1e-6 * 0.01, 1e-15);
 }
 
 }  // namespace

@@ -291,6 +291,7 @@ std::vector<DamageCase> DamageCases() {
       {true, 60, t60 + " 0.2 0 0 0 0 -0.049", "absurd_value", "is 40 rad/s, beyond ±35: angle increments in degrees?"},
       {true, 10, t60.substr(0, 6) + ".045 0 0 0 1.5 0 -0.049", "absurd_value", "is 300 m/s², beyond ±200"},
       {true, 60, "-1" + rest, "absurd_value", "time must be >= 0"},
+      {true, 60, "2e10" + rest, "absurd_value", "column 1 (t) = 20000000000.000000, beyond 1e+10 s"},
       {false, 2, GnssLine(kT0 + 0.2, 91.0), "absurd_value", "column 2 (lat) = 91 deg, beyond ±90"},
       {false, 2, Fixed(kT0 + 0.2, 3) + " 30 -181 20 0.1 0.1 0.1", "absurd_value", "column 3 (lon) = -181 deg"},
       {false, 2, GnssLine(kT0 + 0.2, 30.0, 0.0), "absurd_value", "column 5 (σn) = 0 m, σ must be in (0, 10000)"},

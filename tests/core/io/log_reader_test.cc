@@ -309,6 +309,8 @@ std::vector<DamageCase> DamageCases() {
       {"IMU 1.5 0 0 0 -200.5 0 9.8", "absurd_value"},
       {"IMU 0 0 0 0 0 0 9.8", "absurd_value"},
       {"IMU -1.5 0 0 0 0 0 9.8", "absurd_value"},
+      {"IMU 1e10 0 0 0 0 0 9.8", "absurd_value"},           // not seconds (log_limits::kMaxTime)
+      {"GNSS 1.7e12 31.5 120.4 10.5 170.9 1", "absurd_value"},
       {"ODOM 1.5 1e7 0", "absurd_value"},
       {"ODOM 1.5 0 -1e7", "absurd_value"},
       {"GNSS 1.5 90.5 120.4 10.5 170.9 1", "absurd_value"},

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "test_util.h"
@@ -196,6 +197,50 @@ TEST(StatesCsvWriter, HeaderAndRowRoundTrip) {
   EXPECT_NEAR(v[9], x.q_wb.y(), 1e-9);
   EXPECT_NEAR(v[10], x.q_wb.z(), 1e-9);
   EXPECT_NEAR(v[26], scale, 1e-6);
+}
+
+// No NaN or infinity ever reaches a file: a state with one is refused whole (and the caller told), every
+// other one written. A finite value of any size gets its complete line (the widest: 27 fields of 1e300).
+TEST(StatesCsvWriter, RefusesNonFiniteStatesAndWritesHugeOnesWhole) {
+  const std::string dir = test::MakeTempDir("states_csv_non_finite");
+  const std::string csv = dir + "/eskf_states.csv", tum = dir + "/eskf.tum";
+  const NavState x = SampleState();
+  const Vec3 s(0.1, 0.1, 0.1);
+  const double nan = std::nan(""), inf = HUGE_VAL;
+  NavState huge = x;
+  huge.t += 1.0;
+  huge.p_wb = Vec3::Constant(-1e300);
+  huge.v_w = Vec3::Constant(1e300);
+  {
+    StatesCsvWriter w(csv, "eskf", kOrigin);
+    TumWriter t(tum, "eskf", kOrigin);
+    NavState bad = x;
+    bad.v_w.y() = nan;
+    EXPECT_FALSE(w.Add(bad, s, s, s, 1.0));
+    EXPECT_FALSE(t.Add(bad));
+    EXPECT_FALSE(w.Add(x, s, Vec3(0.1, inf, 0.1), s, 1.0));
+    EXPECT_FALSE(w.Add(x, s, s, Vec3(nan, 0.1, 0.1), 1.0));
+    EXPECT_FALSE(w.Add(x, s, s, s, nan));
+    EXPECT_TRUE(w.Add(x, s, s, s, 1.0));
+    EXPECT_TRUE(w.Add(huge, Vec3::Constant(1e300), Vec3::Constant(1e300), s, 1e300));
+    EXPECT_TRUE(t.Add(x));
+    EXPECT_TRUE(t.Add(huge));
+    EXPECT_EQ(t.count(), 2u);
+    w.Commit();
+    t.Commit();
+  }
+  for (const auto& [path, sep, columns] : {std::tuple{csv, ',', 27u}, std::tuple{tum, ' ', 8u}}) {
+    const std::vector<std::string> lines = Lines(test::ReadFile(path));
+    ASSERT_EQ(lines.size(), path == csv ? 4u : 3u) << path;
+    for (size_t i = lines.size() - 2; i < lines.size(); ++i) {
+      EXPECT_EQ(lines[i].find("nan"), std::string::npos) << lines[i];
+      EXPECT_EQ(lines[i].find("inf"), std::string::npos) << lines[i];
+      const std::vector<double> v = Numbers(lines[i], sep);
+      ASSERT_EQ(v.size(), columns) << path;
+      for (double d : v) EXPECT_TRUE(std::isfinite(d));
+    }
+    EXPECT_DOUBLE_EQ(Numbers(lines.back(), sep)[1], -1e300);
+  }
 }
 
 }  // namespace

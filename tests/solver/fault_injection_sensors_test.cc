@@ -166,13 +166,13 @@ TEST(FaultInjection, WheelsCountZeroWhileMoving) {
 }
 
 // A log that ends during the initialisation. Expected: Finish throws RunError whose one-line message says why
-// (no standstill yet; standstill found but no fix after it) and no state was emitted; a log that ends 0.5 s
+// (too few fixes yet; a standstill found but too few fixes after it) and no state was emitted; a log that ends 0.5 s
 // after the initialisation has its states, all sane.
 TEST(FaultInjection, LogEndsMidInitialisation) {
   const struct {
     double end;  // s after the start
     const char* message;
-  } cases[] = {{1.5, "no standstill found"}, {1.995, "no GNSS fix after it"}};
+  } cases[] = {{1.5, "waiting for more GNSS fixes"}, {1.995, "standstill found"}};
   for (const auto& c : cases) {
     SCOPED_TRACE("log of " + std::to_string(c.end) + " s");
     const SimOptions sim = FaultDrive(26, 30.0);

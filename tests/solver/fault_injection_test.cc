@@ -47,8 +47,8 @@ TEST(FaultInjection, HealthyDriveStaysWithinTheBound) {
 // IMU dropout during the initialiser's standstill (0.05 to 30 s, from 1 s into the 20 s stop, before the
 // initialisation completes). Expected: the initialiser's window goes on across a short dropout and restarts
 // after a long one; states only from the initialisation on, within the bound 5 s after it. A dropout longer
-// than the standstill left (30 s: the IMU returns while driving, and this drive never stops again) leaves no
-// standstill: no initialisation and no state (gins run then refuses the log with "no standstill found").
+// than the standstill left (30 s: the IMU returns while driving) leaves no standstill: the initialiser starts
+// in motion once the IMU is back, with the same bound.
 TEST(FaultInjection, ImuDropoutDuringTheInitialStandstill) {
   for (double d : {0.05, 0.5, 2.0, 10.0, 30.0}) {
     const SimOptions sim = FaultDrive(12, 130.0);
@@ -56,11 +56,6 @@ TEST(FaultInjection, ImuDropoutDuringTheInitialStandstill) {
     const DriveRun run = test::RunDriveThroughSession(
         sim, test::TestRunOptions(sim), Dropping([&](const SimRecord& r) { return IsImu(r) && r.t() > t0 && r.t() < t0 + d; }));
     SCOPED_TRACE("dropout " + std::to_string(d) + " s");
-    if (d > 19.0) {
-      EXPECT_FALSE(run.initialized);
-      EXPECT_TRUE(run.eskf.empty() && run.smoother.empty() && run.smoother_online.empty());
-      continue;
-    }
     ASSERT_TRUE(run.initialized);
     EXPECT_GT(run.init_t, t0 + d);
     test::ExpectSaneOutputs(run);

@@ -56,6 +56,28 @@ BatchSmoother::BatchSmoother(const EstimatorOptions& options, std::vector<BlockT
 
 namespace {
 
+// A problem over the log's keyframes and factors: it owns none of them (the costs are the log's and the
+// priors', the losses the attachers').
+ceres::Problem::Options BorrowingProblemOptions() {
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return po;
+}
+
+std::vector<double*> ParamsOf(const std::vector<BlockRef>& refs) {
+  std::vector<double*> params;
+  params.reserve(refs.size());
+  for (const BlockRef& ref : refs) params.push_back(ref.kf->block(ref.type));
+  return params;
+}
+
+// Adds a logged factor to a problem that borrows it.
+void AddBorrowed(ceres::Problem* problem, const LoggedFactor& f) {
+  problem->AddResidualBlock(f.cost.get(), const_cast<ceres::LossFunction*>(f.loss), ParamsOf(f.blocks));
+}
+
 // A cost the log (or a segment's prior) keeps, lent to a problem that owns what it is given.
 class SharedCost final : public ceres::CostFunction {
  public:
@@ -179,20 +201,13 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
   };
   bool revisited = false;
   for (int round = 0;; ++round) {
-    ceres::Problem::Options po;
-    po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // the log's and the prior's
-    po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // the attachers'
-    po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    ceres::Problem problem(po);
+    ceres::Problem problem(BorrowingProblemOptions());
     auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
     int group = 0;
     for (int k = first; k < last; ++k) AddKeyframeBlocks(&problem, kfs_[k], ordering.get(), &group);
     for (const FactorSpan& f : factors_) {
       if (!inside(f)) continue;
-      const LoggedFactor& lf = log->factors()[f.log_index];
-      std::vector<double*> params;
-      for (const BlockRef& ref : lf.blocks) params.push_back(ref.kf->block(ref.type));
-      problem.AddResidualBlock(lf.cost.get(), const_cast<ceres::LossFunction*>(lf.loss), params);
+      AddBorrowed(&problem, log->factors()[f.log_index]);
     }
     if (prior.cost) problem.AddResidualBlock(prior.cost.get(), nullptr, prior.Params());
 
@@ -272,11 +287,7 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
 void BatchSmoother::SolveBeforeSeam(const FactorLog& log, int first, int seam, const Prior& prior) {
   const int w = stats_.band_keyframes;
   const int end = std::min<int>(kfs_.size(), seam + w);
-  ceres::Problem::Options po;
-  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(po);
+  ceres::Problem problem(BorrowingProblemOptions());
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   int group = 0;
   for (int k = first; k < end; ++k) AddKeyframeBlocks(&problem, kfs_[k], ordering.get(), &group);
@@ -291,9 +302,7 @@ void BatchSmoother::SolveBeforeSeam(const FactorLog& log, int first, int seam, c
     if (f.lo < first || f.lo >= seam || f.hi >= end) continue;
     const LoggedFactor& lf = log.factors()[f.log_index];
     if (!lf.active) continue;
-    std::vector<double*> params;
-    for (const BlockRef& ref : lf.blocks) params.push_back(ref.kf->block(ref.type));
-    problem.AddResidualBlock(lf.cost.get(), const_cast<ceres::LossFunction*>(lf.loss), params);
+    AddBorrowed(&problem, lf);
   }
   if (prior.cost) problem.AddResidualBlock(prior.cost.get(), nullptr, prior.Params());
   const ceres::Solver::Options so = ChainSolverOptions(ordering, options_.batch.max_iterations,
@@ -346,11 +355,7 @@ bool BatchSmoother::Revisit(FactorLog* log, int first, int last, const std::vect
   return changed;
 }
 
-std::vector<double*> BatchSmoother::Prior::Params() const {
-  std::vector<double*> params;
-  for (const BlockRef& ref : blocks) params.push_back(ref.kf->block(ref.type));
-  return params;
-}
+std::vector<double*> BatchSmoother::Prior::Params() const { return ParamsOf(blocks); }
 
 BatchSmoother::Prior BatchSmoother::MarginalPrior(const FactorLog& log, int first, int seam, const Prior& previous) {
   // The window's marginalisation, keyframe after keyframe from `first` up to the seam, at this segment's
@@ -385,9 +390,7 @@ BatchSmoother::Prior BatchSmoother::MarginalPrior(const FactorLog& log, int firs
     for (; next < by_lo.size() && by_lo[next]->lo == k; ++next) {
       const LoggedFactor& lf = log.factors()[by_lo[next]->log_index];
       add_blocks(lf.blocks);
-      std::vector<double*> params;
-      for (const BlockRef& ref : lf.blocks) params.push_back(ref.kf->block(ref.type));
-      problem.AddResidualBlock(new SharedCost(lf.cost), const_cast<ceres::LossFunction*>(lf.loss), params);
+      problem.AddResidualBlock(new SharedCost(lf.cost), const_cast<ceres::LossFunction*>(lf.loss), ParamsOf(lf.blocks));
     }
     AddKeyframeBlocks(&problem, kfs_[k], nullptr, nullptr);
     std::vector<double*> blocks;

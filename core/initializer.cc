@@ -17,6 +17,26 @@ constexpr double kMaxWindow = 60.0;  // s
 constexpr double kAttemptInterval = 1.0;  // s
 // A standstill's fixes kept for the fit (the antenna stands: more say little).
 constexpr size_t kMaxStandstillFixes = 50;
+// At most this many of each measurement in motion enter a fit, evenly spread over the window: a 60 s window
+// of 20 Hz fixes or 100 Hz wheels would make every attempt cost seconds (slower than the log on a stream),
+// while neighbouring metre-level fixes share most of their error and add little.
+constexpr size_t kMaxFitMeasurements = 200;
+
+// The measurements of `all` in [t0, t1] (TimeOf(m) their epoch), at most kMaxFitMeasurements of them evenly
+// spread by index, the newest always kept, appended to *out.
+template <class M, class TimeOf>
+void AppendThinned(const std::deque<M>& all, double t0, double t1, TimeOf time_of, std::vector<M>* out) {
+  std::vector<const M*> in;
+  for (const M& m : all) {
+    if (time_of(m) >= t0 && m.t <= t1) in.push_back(&m);
+  }
+  const size_t n = in.size(), keep = std::min(n, kMaxFitMeasurements);
+  for (size_t k = 0; k < keep; ++k) {
+    // Index k·(n−1)/(keep−1) rounded: the first and the last are kept.
+    const size_t i = keep == 1 ? n - 1 : (k * (n - 1) + (keep - 1) / 2) / (keep - 1);
+    out->push_back(*in[i]);
+  }
+}
 // Another yaw must explain the window worse by this χ²(1) quantile to rule it out.
 constexpr double kAmbiguityProbability = 0.9999;
 // The GNSS must rule out a zero speed at this probability before a fit is tried.
@@ -229,15 +249,10 @@ bool Initializer::BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bo
   // The window of motion is as long as it gets: from now on it slides, and the fit gets no better by
   // waiting.
   *full = fix.t - t0 >= length - kAttemptInterval;
-  for (const GnssMeasurement& f : fixes_) {
-    if (f.t >= t0 && f.t <= fix.t) in->fixes.push_back(f);
-  }
-  for (const GvelMeasurement& g : gvels_) {
-    if (g.t >= t0 && g.t <= fix.t) in->gvels.push_back(g);
-  }
-  for (const WheelMeasurement& w : wheels_) {
-    if (w.t - 0.5 * w.interval >= t0 && w.t <= fix.t) in->wheels.push_back(w);
-  }
+  const auto at = [](const auto& m) { return m.t; };
+  AppendThinned(fixes_, t0, fix.t, at, &in->fixes);
+  AppendThinned(gvels_, t0, fix.t, at, &in->gvels);
+  AppendThinned(wheels_, t0, fix.t, [](const WheelMeasurement& w) { return w.t - 0.5 * w.interval; }, &in->wheels);
   if (in->fixes.size() < 3) {
     last_problem_ = "waiting for more GNSS fixes";
     return false;

@@ -105,9 +105,14 @@ void MeasurementCounts::Reject(const std::string& reason, double t) {
 
 nlohmann::json MeasurementCounts::ToJson() const {
   nlohmann::json j;
+  uint64_t offered = used;
   j["used"] = used;
   j["rejected"] = nlohmann::json::object();
-  for (const auto& [k, v] : rejected) j["rejected"][k] = v;
+  for (const auto& [k, v] : rejected) {
+    j["rejected"][k] = v;
+    offered += v;
+  }
+  j["offered"] = offered;
   j["rejected_times"] = rejected_times;
   return j;
 }

@@ -27,7 +27,8 @@ struct StateEstimate {
 
 using StateCallback = std::function<void(const StateEstimate&)>;
 
-// Counts of one measurement type: used, and rejected by reason.
+// Counts of one measurement type: used, and rejected by reason; in the summary also "offered", the two
+// together (every measurement of the type that reached the estimator's check).
 struct MeasurementCounts {
   uint64_t used = 0;
   std::map<std::string, uint64_t> rejected;

@@ -44,6 +44,9 @@ constexpr double kMotionProbability = 0.999;
 // Over a full window a fit is accepted with a yaw 1-σ up to this: the iterated updates converge from tens of
 // degrees; far beyond, the linearised estimators would not.
 constexpr double kMaxSettledYawSigma = 30.0 * kDegToRad;
+// ... and roll and pitch 1-σ up to this: gravity observes them within seconds once the estimators run, and
+// at 3 σ (15°) the linearised gravity is off by 1 − cos 15° ≈ 3 % of g, which the iterated update absorbs.
+constexpr double kMaxSettledTiltSigma = 5.0 * kDegToRad;
 // Floors of the initial covariance (1-σ): the estimators invert it.
 constexpr double kFloorPos = 1e-3, kFloorVel = 1e-3, kFloorAtt = 1e-5, kFloorBg = 1e-7, kFloorBa = 1e-5;
 
@@ -280,26 +283,35 @@ void Initializer::TryFit(const GnssMeasurement& fix) {
   Finish(a, fix, from_standstill ? last_standstill_ : std::nullopt);
 }
 
+bool FitStartsEstimators(const AlignmentFit& a, bool window_full, double max_attitude_sigma, double max_tilt_sigma) {
+  const double chi2_1 = Chi2Quantile(kAmbiguityProbability, 1);
+  if (a.yaw_sigma <= max_attitude_sigma && a.tilt_sigma <= max_tilt_sigma &&
+      a.runner_up_delta_chi2 > chi2_1 * a.inflation) {
+    return true;
+  }
+  // A slow vehicle on metre-level fixes may never give a precise yaw, nor (its residuals correlated) a
+  // precise roll and pitch. Once the window is as long as it gets, the fit is as good as it will be: the
+  // estimators start from it with its σ, unless another yaw fits about as well (its χ² not inflated by the
+  // residuals' correlation here: the fit's σ covers that).
+  return window_full && a.yaw_sigma <= kMaxSettledYawSigma && a.tilt_sigma <= kMaxSettledTiltSigma &&
+         a.runner_up_delta_chi2 > chi2_1;
+}
+
 bool Initializer::Acceptable(const AlignmentFit& a, bool window_full) {
   const double max_att = options_.init.max_attitude_sigma;
   const double max_tilt = std::hypot(max_att, options_.imu.init_acc_bias_sigma / earth_.g_norm());
   const double chi2_1 = Chi2Quantile(kAmbiguityProbability, 1);
-  const double ambiguity = chi2_1 * a.inflation;
   std::ostringstream os;
   os << "moving; the last fit (" << a.fixes_used << " fixes) gives yaw σ " << Deg(a.yaw_sigma) << " deg (needs ≤ "
      << Deg(max_att) << ", or ≤ " << Deg(kMaxSettledYawSigma) << " over a full window), roll/pitch σ "
-     << Deg(a.tilt_sigma) << " deg (needs ≤ " << Deg(max_tilt) << ")";
+     << Deg(a.tilt_sigma) << " deg (needs ≤ " << Deg(max_tilt) << ", or ≤ " << Deg(kMaxSettledTiltSigma)
+     << " over a full window)";
   if (std::isfinite(a.runner_up_delta_chi2)) {
     os << ", another yaw " << Deg(a.runner_up_yaw) << " deg is worse by χ² " << a.runner_up_delta_chi2
-       << " (needs > " << ambiguity << ", or > " << chi2_1 << " over a full window)";
+       << " (needs > " << chi2_1 * a.inflation << ", or > " << chi2_1 << " over a full window)";
   }
   last_problem_ = os.str();
-  if (a.yaw_sigma <= max_att && a.tilt_sigma <= max_tilt && a.runner_up_delta_chi2 > ambiguity) return true;
-  // A slow vehicle on metre-level fixes may never give a precise yaw. Once the window is as long as it gets,
-  // the fit is as good as it will be: the estimators start from it with its σ, unless another yaw fits
-  // about as well (its χ² not inflated by the residuals' correlation here: the fit's σ covers that).
-  return window_full && a.yaw_sigma <= kMaxSettledYawSigma && a.tilt_sigma <= max_tilt &&
-         a.runner_up_delta_chi2 > chi2_1;
+  return FitStartsEstimators(a, window_full, max_att, max_tilt);
 }
 
 void Initializer::Finish(const AlignmentFit& a, const GnssMeasurement& fix, const std::optional<Standstill>& standstill) {

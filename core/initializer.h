@@ -72,6 +72,13 @@ struct InitResult {
   double chi2_per_dof = 0.0, inflation = 1.0, runner_up_delta_chi2 = 0.0;
 };
 
+// Whether an alignment fit may start the estimators (README "Initialisation"): its yaw σ within
+// max_attitude_sigma and its roll/pitch σ within max_tilt_sigma, no other yaw explaining the window nearly as
+// well (Δχ² above the χ²(1) 99.99 % quantile times the fit's inflation); or, once the window is as long as it
+// gets (window_full), a settled fit: yaw σ up to 30°, roll/pitch σ up to 5°, the other yaw ruled out at the
+// plain quantile.
+bool FitStartsEstimators(const AlignmentFit& a, bool window_full, double max_attitude_sigma, double max_tilt_sigma);
+
 class Initializer {
  public:
   Initializer(const InitializerOptions& options, const EarthModel& earth);

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -256,6 +257,43 @@ TEST(StaticInitializer, NeverStandingStillInitialisesInMotion) {
   EXPECT_EQ(run.result.start, "moving");
   EXPECT_EQ(run.result.static_end, 0.0);
   EXPECT_LT(std::abs(YawErrorDeg(run.result.x0, run.truth)), 1.0);
+}
+
+}  // namespace
+}  // namespace gins
+
+namespace gins {
+namespace {
+
+// When a fit starts the estimators (FitStartsEstimators): precise enough, or settled over a full window.
+TEST(FitStartsEstimators, PreciseOrSettledOverAFullWindow) {
+  constexpr double kDeg = kDegToRad;
+  const double max_att = 1.0 * kDeg, max_tilt = 1.04 * kDeg;
+  const auto fit = [](double yaw_deg, double tilt_deg, double runner_up, double inflation = 1.0) {
+    AlignmentFit a;
+    a.yaw_sigma = yaw_deg * kDegToRad;
+    a.tilt_sigma = tilt_deg * kDegToRad;
+    a.runner_up_delta_chi2 = runner_up;
+    a.inflation = inflation;
+    return a;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  // Precise: at any time, unless another yaw explains the window nearly as well (the inflated quantile).
+  EXPECT_TRUE(FitStartsEstimators(fit(0.5, 0.5, inf), false, max_att, max_tilt));
+  EXPECT_TRUE(FitStartsEstimators(fit(0.5, 0.5, 200.0, 10.0), false, max_att, max_tilt));
+  EXPECT_FALSE(FitStartsEstimators(fit(0.5, 0.5, 100.0, 10.0), false, max_att, max_tilt));  // 15.1 × 10
+  EXPECT_FALSE(FitStartsEstimators(fit(0.5, 1.2, inf), false, max_att, max_tilt));
+  // Not precise: only once the window is full, with yaw σ ≤ 30° and roll/pitch σ ≤ 5° (a slow rover's
+  // correlated fixes leave both above the precise limits).
+  EXPECT_FALSE(FitStartsEstimators(fit(20.0, 0.5, inf), false, max_att, max_tilt));
+  EXPECT_TRUE(FitStartsEstimators(fit(20.0, 0.5, inf), true, max_att, max_tilt));
+  EXPECT_TRUE(FitStartsEstimators(fit(29.0, 1.5, inf), true, max_att, max_tilt));
+  EXPECT_TRUE(FitStartsEstimators(fit(29.0, 4.9, inf), true, max_att, max_tilt));
+  EXPECT_FALSE(FitStartsEstimators(fit(29.0, 5.1, inf), true, max_att, max_tilt));
+  EXPECT_FALSE(FitStartsEstimators(fit(31.0, 0.5, inf), true, max_att, max_tilt));
+  // Settled, but another yaw within the plain χ²(1) 99.99 % quantile (15.1) of the best: ambiguous.
+  EXPECT_FALSE(FitStartsEstimators(fit(20.0, 0.5, 14.0, 10.0), true, max_att, max_tilt));
+  EXPECT_TRUE(FitStartsEstimators(fit(20.0, 0.5, 16.0, 10.0), true, max_att, max_tilt));
 }
 
 }  // namespace

@@ -23,6 +23,23 @@ uint64_t Resets(const DriveRun& run, const char* estimator) {
   return run.stats["estimators"][estimator]["watchdog"]["count"].get<uint64_t>();
 }
 
+// The drift in the GNSS outage [outage, outage_end] of each estimator of `run` is within 1.5× (+0.5 m) of the
+// same drive's without wheels at all: wheels that fail are at worst ignored.
+void ExpectOutageDriftAsWithoutWheels(const SimOptions& sim, const DriveRun& run, double outage, double outage_end,
+                                      const char* fault) {
+  Options no_wheels = test::TestRunOptions(sim);
+  no_wheels.wheel.enabled = false;
+  const DriveRun reference = test::RunDriveThroughSession(sim, no_wheels);
+  ASSERT_TRUE(reference.initialized);
+  for (const auto& [name, states, ref] : {std::tuple{"eskf", &run.eskf, &reference.eskf},
+                                         std::tuple{"smoother", &run.smoother, &reference.smoother}}) {
+    const double drift = test::HorizontalErrors(run, *states, outage, outage_end).max_h;
+    const double ref_drift = test::HorizontalErrors(reference, *ref, outage, outage_end).max_h;
+    std::printf("%s: outage drift %.3f m with %s, %.3f m without wheels\n", name, drift, fault, ref_drift);
+    EXPECT_LT(drift, 1.5 * ref_drift + 0.5) << name;
+  }
+}
+
 // A GNSS jump of 1 km that lasts (the receiver's positions move for good at 60 s: a new datum, a wrong base
 // station). Expected: every fix is rejected (χ²) while the estimate coasts on the IMU and wheels; after
 // watchdog.max_reject_s (15 s) the watchdog re-initialises from the fix (one reset, reason gnss_rejected) and
@@ -78,19 +95,9 @@ TEST(FaultInjection, WheelsStopReporting) {
   const DriveRun run = test::RunDriveThroughSession(sim, test::TestRunOptions(sim), Editing([&](SimRecord* r) {
     return !(r->type == SimRecord::Type::kOdom && r->t() >= t0);
   }));
-  Options no_wheels = test::TestRunOptions(sim);
-  no_wheels.wheel.enabled = false;
-  const DriveRun reference = test::RunDriveThroughSession(sim, no_wheels);
-  ASSERT_TRUE(run.initialized && reference.initialized);
+  ASSERT_TRUE(run.initialized);
   test::ExpectSaneOutputs(run);
-  for (const auto& [name, states, ref] : {std::tuple{"eskf", &run.eskf, &reference.eskf},
-                                         std::tuple{"smoother", &run.smoother, &reference.smoother}}) {
-    const double drift = test::HorizontalErrors(run, *states, outage, outage_end).max_h;
-    const double ref_drift = test::HorizontalErrors(reference, *ref, outage, outage_end).max_h;
-    std::printf("%s: outage drift %.3f m with the wheels silent from 40 s, %.3f m without wheels\n", name, drift,
-                ref_drift);
-    EXPECT_LT(drift, 1.5 * ref_drift + 0.5) << name;
-  }
+  ExpectOutageDriftAsWithoutWheels(sim, run, outage, outage_end, "the wheels silent from 40 s");
   EXPECT_GT(run.stats["standstill_updates"].get<uint64_t>(), 50u);
   ExpectRecovery("wheels stop reporting (then a 20 s GNSS outage)", run, outage, outage_end, sim.start_time + 155.0, 5.0);
 }
@@ -150,16 +157,10 @@ TEST(FaultInjection, WheelsCountZeroWhileMoving) {
     if (r->type == SimRecord::Type::kOdom && r->t() >= t0) r->odom.left_pulses = r->odom.right_pulses = 0.0;
     return true;
   }));
-  Options no_wheels = test::TestRunOptions(sim);
-  no_wheels.wheel.enabled = false;
-  const DriveRun reference = test::RunDriveThroughSession(sim, no_wheels);
-  ASSERT_TRUE(run.initialized && reference.initialized);
+  ASSERT_TRUE(run.initialized);
   test::ExpectSaneOutputs(run);
-  for (const auto& [name, states, ref] : {std::tuple{"eskf", &run.eskf, &reference.eskf},
-                                         std::tuple{"smoother", &run.smoother, &reference.smoother}}) {
-    const double drift = test::HorizontalErrors(run, *states, outage, outage_end).max_h;
-    const double ref_drift = test::HorizontalErrors(reference, *ref, outage, outage_end).max_h;
-    EXPECT_LT(drift, 1.5 * ref_drift + 0.5) << name;
+  ExpectOutageDriftAsWithoutWheels(sim, run, outage, outage_end, "the wheels counting zero from 40 s");
+  for (const char* name : {"eskf", "smoother"}) {
     EXPECT_GT(run.stats["estimators"][name]["wheel"]["rejected"].value("chi2_gate", 0u), 100u) << name;
   }
   ExpectRecovery("wheels count zero while moving", run, t0, outage_end, sim.start_time + 155.0, 5.0);

@@ -12,6 +12,7 @@
 
 #include "core/geodesy.h"
 #include "core/sim/simulator.h"
+#include "fault_harness.h"
 #include "solver/eskf.h"
 #include "solver/session.h"
 #include "solver/smoother.h"
@@ -72,29 +73,8 @@ Output RunDrive(const SimOptions& sim, const Options& options, const Edit& edit)
   return out;
 }
 
-// The drive cut after `duration` seconds (keeps the tests cheap, also under the sanitizers).
-SimOptions Shortened(SimOptions sim, double duration) {
-  std::vector<SimSegment> kept;
-  double t = 0.0;
-  for (SimSegment seg : sim.segments) {
-    if (t >= duration) break;
-    seg.duration = std::min(seg.duration, duration - t);
-    t += seg.duration;
-    kept.push_back(seg);
-  }
-  sim.segments = kept;
-  return sim;
-}
-
-// Moves a fix by (east, north) metres in the simulation's world frame.
-void Displace(const SimOptions& sim, double east, double north, GnssRecord* g) {
-  const LocalEnuFrame frame(sim.origin);
-  const Vec3 p = frame.ToEnu({g->lat_deg, g->lon_deg, g->alt_m}) + Vec3(east, north, 0.0);
-  const GeodeticPoint q = frame.ToGeodetic(p);
-  g->lat_deg = q.lat_deg;
-  g->lon_deg = q.lon_deg;
-  g->alt_m = q.alt_m;
-}
+using test::Displace;
+using test::Shortened;
 
 // Largest horizontal error over states with t in [t0, t1], against the truth shifted by `offset`.
 double MaxHorizontalError(const Output& out, const std::vector<StateEstimate>& states, double t0, double t1,
@@ -131,7 +111,7 @@ TEST(RobustnessEndToEnd, BurstOfEightWildFixesIsRejectedByBothEstimators) {
     std::vector<double> burst;
     const Output out = RunDrive(sim, options, [&](SimRecord* r) {
       if (r->type == SimRecord::Type::kGnss && r->gnss.t >= burst_start && burst.size() < 8) {
-        Displace(sim, 30.0, -40.0, &r->gnss);  // 50 m
+        Displace(sim, Vec3(30.0, -40.0, 0.0), &r->gnss);  // 50 m
         burst.push_back(r->gnss.t);
       }
       return true;
@@ -165,7 +145,7 @@ TEST(RobustnessEndToEnd, WatchdogAcceptsAPersistentGnssStep) {
   const double step_t = sim.start_time + 95.0;
   const Vec3 step(30.0, 0.0, 0.0);
   const Output out = RunDrive(sim, options, [&](SimRecord* r) {
-    if (r->type == SimRecord::Type::kGnss && r->gnss.t >= step_t) Displace(sim, step.x(), step.y(), &r->gnss);
+    if (r->type == SimRecord::Type::kGnss && r->gnss.t >= step_t) Displace(sim, step, &r->gnss);
     return true;
   });
   for (const auto& [name, stats, states] :

@@ -16,6 +16,7 @@
 #include "core/eval/run_comparison.h"
 #include "core/geodesy.h"
 #include "core/io/batch_pipe.h"
+#include "core/io/read_ahead.h"
 #include "core/io/trajectory_writer.h"
 #include "core/io/truth_reader.h"
 
@@ -289,10 +290,15 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
   });
 
   const ReadStats& read_stats = api::internal::Access::read_stats(reader);
-  api::Record rec;
-  while (reader.Next(&rec)) {
-    session.Push(rec);
-    CheckInitTimeout(request.log_path, options.init.max_wait, session);
+  {
+    // Reading and parsing run on a third thread, ahead of the estimators (a read error surfaces here, after
+    // the records before it, as from a direct read). Gone before read_stats is read.
+    ReadAhead<api::Record> records([&reader](api::Record* r) { return reader.Next(r); });
+    api::Record rec;
+    while (records.Next(&rec)) {
+      session.Push(rec);
+      CheckInitTimeout(request.log_path, options.init.max_wait, session);
+    }
   }
   CheckReadCounts(request.log_path, read_stats);
   FinishSession(request.log_path, &session);

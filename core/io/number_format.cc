@@ -1,9 +1,11 @@
 #include "core/io/number_format.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 
 namespace gins {
@@ -15,6 +17,7 @@ constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8
                              1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 constexpr int kMaxPow10 = 22;
 constexpr double kMaxInteger = 1.0e18;  // the integer part fits a uint64_t
+constexpr double kLog10Of2 = 0.30102999566398120;
 
 // x ≥ 0 (below 2^62) rounded to the nearest integer, ties to even as to_chars does; inline, unlike rint.
 uint64_t RoundHalfEven(double x) {
@@ -28,32 +31,52 @@ char* Fallback(char* first, char* last, double v, std::chars_format format, int 
   return r.ec == std::errc() ? r.ptr : first;
 }
 
-// Digits of n, at least `min_digits` of them (zero-padded), into [first, last).
 // "00" "01" ... "99": two digits per division halves the dependent chain of divisions.
 constexpr char kDigitPairs[] =
     "00010203040506070809101112131415161718192021222324252627282930313233343536373839404142434445464748495051525354"
     "555657585960616263646566676869707172737475767778798081828384858687888990919293949596979899";
 
+// 10^0 ... 10^19, every power of ten a uint64_t holds.
+constexpr uint64_t kPow10U[20] = {1ULL,
+                                  10ULL,
+                                  100ULL,
+                                  1000ULL,
+                                  10000ULL,
+                                  100000ULL,
+                                  1000000ULL,
+                                  10000000ULL,
+                                  100000000ULL,
+                                  1000000000ULL,
+                                  10000000000ULL,
+                                  100000000000ULL,
+                                  1000000000000ULL,
+                                  10000000000000ULL,
+                                  100000000000000ULL,
+                                  1000000000000000ULL,
+                                  10000000000000000ULL,
+                                  100000000000000000ULL,
+                                  1000000000000000000ULL,
+                                  10000000000000000000ULL};
+
+// Decimal digits of n (0 for 0): from its bit length (1233/4096 ≈ log10 2), then one comparison.
+int DigitCount(uint64_t n) {
+  const int t = ((64 - __builtin_clzll(n | 1)) * 1233) >> 12;
+  return t + 1 - (n < kPow10U[t] ? 1 : 0);
+}
+
+// Digits of n, at least `min_digits` of them (zero-padded), into [first, last).
 char* WriteDigits(char* first, char* last, uint64_t n, int min_digits) {
-  int k = 1;
-  for (uint64_t ten_k = 10; k < 19 && n >= ten_k; ten_k *= 10) ++k;
-  if (k == 19 && n >= 10000000000000000000ULL) k = 20;
-  if (k < min_digits) k = min_digits;
+  const int k = std::max({DigitCount(n), min_digits, 1});
   if (last - first < k) return nullptr;
+  // Exactly k digits, right to left: the leading zeros come out of n's own pairs (no padding pass).
   char* p = first + k;
-  while (n >= 100) {
+  while (p - first >= 2) {
     const uint64_t pair = n % 100;
     n /= 100;
     *--p = kDigitPairs[2 * pair + 1];
     *--p = kDigitPairs[2 * pair];
   }
-  if (n >= 10) {
-    *--p = kDigitPairs[2 * n + 1];
-    *--p = kDigitPairs[2 * n];
-  } else {
-    *--p = static_cast<char>('0' + n);
-  }
-  while (p > first) *--p = '0';
+  if (p > first) *--p = static_cast<char>('0' + n % 10);
   return first + k;
 }
 
@@ -96,7 +119,14 @@ char* FormatScientific(char* first, char* last, double v, int precision) {
     return Fallback(first, last, v, std::chars_format::scientific, precision);
   }
   const double a = std::abs(v);
-  int e = static_cast<int>(std::floor(std::log10(a)));
+  // The decimal exponent from the binary one, without log10 (a third of the writer's time at IMU rate):
+  // a ∈ [2^k, 2^(k+1)) gives floor(k·log10 2) ≤ floor(log10 a), at most one below; the loop below steps it
+  // up. Never above: where both e and e + 1 give digits in range (a just below a power of ten), e is right.
+  uint64_t bits = 0;
+  std::memcpy(&bits, &a, sizeof(bits));
+  const int biased = static_cast<int>(bits >> 52) & 0x7ff;  // a = 1.f·2^(biased − 1023); 0: subnormal
+  if (biased == 0) return Fallback(first, last, v, std::chars_format::scientific, precision);
+  int e = static_cast<int>(std::floor((biased - 1023) * kLog10Of2));
   // Mantissa digits: a / 10^e scaled by 10^precision, computed as one product or quotient of exact powers.
   auto digits = [&](int exp10) -> long long {
     const int shift = precision - exp10;  // a · 10^shift
@@ -106,8 +136,8 @@ char* FormatScientific(char* first, char* last, double v, int precision) {
   };
   long long n = digits(e);
   const long long lo = static_cast<long long>(kPow10[precision]);
-  if (n >= 10 * lo) n = digits(++e);  // log10 below a power of ten, or rounding up to one (9.99995 -> 10.000)
-  if (n >= 0 && n < lo) n = digits(--e);
+  // Up from the estimate, and once more when the mantissa rounds up to ten (9.99995 -> 10.000).
+  for (int step = 0; step < 2 && n >= 10 * lo; ++step) n = digits(++e);
   if (n < lo || n >= 10 * lo) return Fallback(first, last, v, std::chars_format::scientific, precision);
   const uint64_t un = static_cast<uint64_t>(n), ulo = static_cast<uint64_t>(lo);
   char* p = WriteDecimal(first, last, v < 0.0, un / ulo, un % ulo, precision);

@@ -41,6 +41,22 @@ TEST(NumberFormat, MatchesToCharsOnTypicalValues) {
   }
 }
 
+// The decimal exponent comes from the binary one: next to every power of ten (where the exponent changes, and
+// where a mantissa rounds up to 10) the text is to_chars's exactly (decimal ties aside, see below).
+TEST(NumberFormat, ScientificMatchesToCharsNextToPowersOfTen) {
+  for (int e = -30; e <= 30; ++e) {
+    const double p10 = std::pow(10.0, e);
+    const double values[] = {p10, std::nextafter(p10, 0.0), std::nextafter(p10, 1e300), p10 * (1.0 - 4e-5),
+                             p10 * (1.0 - 6e-5), p10 * (1.0 - 4e-10), p10 * 2.0, p10 * 0.5};
+    for (double v : values) {
+      for (int p = 0; p <= 9; ++p) {
+        EXPECT_EQ(Ours(v, p, true), Reference(v, p, true)) << v << " scientific " << p;
+        EXPECT_EQ(Ours(-v, p, true), Reference(-v, p, true)) << -v << " scientific " << p;
+      }
+    }
+  }
+}
+
 // Random values over the ranges the output files carry: the text is to_chars's except, rarely, one unit in
 // the last place at a decimal tie, and always parses back within half a unit (plus binary rounding).
 TEST(NumberFormat, RandomValuesWithinHalfAUnitOfTheLastPlace) {

@@ -50,7 +50,23 @@ StandstillDetector::StandstillDetector(const StandstillOptions& options, double 
 void StandstillDetector::AddImu(const ImuSample& imu) {
   t_ = imu.t;
   imu_.push_back(imu);
-  while (!imu_.empty() && t_ - imu_.front().t > options_.window) imu_.pop_front();
+  const CumulativeSums d = Deviations(imu);
+  CumulativeSums c = cum_.empty() ? cum_before_ : cum_.back();
+  c.g += d.g;
+  c.a += d.a;
+  cum_.push_back(c);
+  sq_g_ += d.g.cwiseAbs2();
+  sq_a_ += d.a.cwiseAbs2();
+  while (!imu_.empty() && t_ - imu_.front().t > options_.window) {
+    const CumulativeSums out = Deviations(imu_.front());
+    sq_g_ -= out.g.cwiseAbs2();
+    sq_a_ -= out.a.cwiseAbs2();
+    cum_before_ = cum_.front();
+    cum_.pop_front();
+    imu_.pop_front();
+    ++removed_;
+  }
+  if (removed_ >= imu_.size()) Rebase();
   const double keep = std::max(options_.window, 2.0 * wheel_interval_);
   while (!wheels_.empty() && t_ - wheels_.front().t > keep) wheels_.pop_front();
   while (!fixes_.empty() && t_ - fixes_.front().t > kMaxGnssSpan) fixes_.pop_front();
@@ -66,23 +82,38 @@ void StandstillDetector::AddWheel(const WheelMeasurement& wheel) { wheels_.push_
 void StandstillDetector::AddGnss(const GnssMeasurement& fix) { fixes_.push_back(fix); }
 void StandstillDetector::AddGvel(const GvelMeasurement& vel) { gvels_.push_back(vel); }
 
+StandstillDetector::CumulativeSums StandstillDetector::Deviations(const ImuSample& s) const {
+  return {s.gyro - ref_g_, s.acc - ref_a_};
+}
+
+void StandstillDetector::Rebase() {
+  // Deviations about a sample of the window keep the variance accurate next to |g|.
+  ref_g_ = imu_.empty() ? Vec3::Zero() : imu_.front().gyro;
+  ref_a_ = imu_.empty() ? Vec3::Zero() : imu_.front().acc;
+  cum_before_ = CumulativeSums{};
+  cum_.clear();
+  sq_g_.setZero();
+  sq_a_.setZero();
+  removed_ = 0;
+  CumulativeSums c;
+  for (const ImuSample& s : imu_) {
+    const CumulativeSums d = Deviations(s);
+    c.g += d.g;
+    c.a += d.a;
+    cum_.push_back(c);
+    sq_g_ += d.g.cwiseAbs2();
+    sq_a_ += d.a.cwiseAbs2();
+  }
+}
+
 bool StandstillDetector::WindowQuiet() const {
   // A window with a gap, or too short, says nothing.
   if (imu_.size() < 10 || imu_.back().t - imu_.front().t < 0.9 * options_.window) return false;
   const double n = static_cast<double>(imu_.size());
-  // Shifted sums (about the first sample) keep the variance accurate next to |g|.
-  const Vec3 g0 = imu_.front().gyro, a0 = imu_.front().acc;
-  Vec3 sg = Vec3::Zero(), sa = Vec3::Zero(), sg2 = Vec3::Zero(), sa2 = Vec3::Zero();
-  for (const ImuSample& s : imu_) {
-    const Vec3 dg = s.gyro - g0, da = s.acc - a0;
-    sg += dg;
-    sa += da;
-    sg2 += dg.cwiseAbs2();
-    sa2 += da.cwiseAbs2();
-  }
-  const Vec3 var_g = (sg2 / n - (sg / n).cwiseAbs2()).cwiseMax(0.0);
-  const Vec3 var_a = (sa2 / n - (sa / n).cwiseAbs2()).cwiseMax(0.0);
-  const Vec3 mean_g = g0 + sg / n, mean_a = a0 + sa / n;
+  const Vec3 sg = cum_.back().g - cum_before_.g, sa = cum_.back().a - cum_before_.a;
+  const Vec3 var_g = (sq_g_ / n - (sg / n).cwiseAbs2()).cwiseMax(0.0);
+  const Vec3 var_a = (sq_a_ / n - (sa / n).cwiseAbs2()).cwiseMax(0.0);
+  const Vec3 mean_g = ref_g_ + sg / n, mean_a = ref_a_ + sa / n;
   if (!(var_g.maxCoeff() < options_.max_gyro_std * options_.max_gyro_std &&
         var_a.maxCoeff() < options_.max_acc_std * options_.max_acc_std && mean_g.norm() < kMaxMeanRate &&
         std::abs(mean_a.norm() - g_norm_) < kMaxAccNormError)) {
@@ -90,15 +121,12 @@ bool StandstillDetector::WindowQuiet() const {
   }
   // A vehicle that starts to move gently is still quiet over the window for a while: the newest part of the
   // window must also agree with its oldest part (means over a fifth of the window each, within half the
-  // standard-deviation thresholds).
+  // standard-deviation thresholds). The reference cancels in their difference.
   const size_t k = std::max<size_t>(2, imu_.size() / 5);
-  Vec3 old_g = Vec3::Zero(), old_a = Vec3::Zero(), new_g = Vec3::Zero(), new_a = Vec3::Zero();
-  for (size_t i = 0; i < k; ++i) {
-    old_g += imu_[i].gyro;
-    old_a += imu_[i].acc;
-    new_g += imu_[imu_.size() - 1 - i].gyro;
-    new_a += imu_[imu_.size() - 1 - i].acc;
-  }
+  const CumulativeSums& old_end = cum_[k - 1];
+  const CumulativeSums& new_start = cum_[imu_.size() - 1 - k];
+  const Vec3 old_g = old_end.g - cum_before_.g, old_a = old_end.a - cum_before_.a;
+  const Vec3 new_g = cum_.back().g - new_start.g, new_a = cum_.back().a - new_start.a;
   const double kk = static_cast<double>(k);
   return ((new_g - old_g) / kk).cwiseAbs().maxCoeff() < 0.5 * options_.max_gyro_std &&
          ((new_a - old_a) / kk).cwiseAbs().maxCoeff() < 0.5 * options_.max_acc_std;

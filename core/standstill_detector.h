@@ -67,6 +67,15 @@ class StandstillDetector {
 
  private:
   bool WindowQuiet() const;
+  // Running sums over the window, so that judging it costs O(1) per sample, not O(window): each sample's
+  // cumulative sums of gyro and accelerometer deviations from a reference sample (so any stretch's sum is a
+  // difference of two), and the window's sums of squared deviations. Rebased on the window's oldest sample
+  // once per window length, which bounds the rounding.
+  struct CumulativeSums {
+    Vec3 g = Vec3::Zero(), a = Vec3::Zero();
+  };
+  void Rebase();
+  CumulativeSums Deviations(const ImuSample& s) const;
   // The GNSS's verdict over the quiet stretch: kStanding, kMoving, kUndecided, or kQuietUnwitnessed when
   // there is nothing to judge by; *witness says which record type decided.
   State GnssVerdict(Witness* witness) const;
@@ -75,6 +84,11 @@ class StandstillDetector {
   double g_norm_;
   double wheel_interval_;
   std::deque<ImuSample> imu_;
+  std::deque<CumulativeSums> cum_;  // one per sample of imu_, from the last rebase
+  CumulativeSums cum_before_;        // of the samples removed since the last rebase
+  Vec3 ref_g_ = Vec3::Zero(), ref_a_ = Vec3::Zero();
+  Vec3 sq_g_ = Vec3::Zero(), sq_a_ = Vec3::Zero();  // the window's sums of squared deviations
+  size_t removed_ = 0;                              // samples removed since the last rebase
   std::deque<WheelMeasurement> wheels_;
   std::deque<GnssMeasurement> fixes_;
   std::deque<GvelMeasurement> gvels_;

@@ -39,8 +39,9 @@ Kinematics ImuStep(const Kinematics& x, const Vec3& omega, const Vec3& acc, cons
 // Products with the step Jacobians that skip their zero and identity blocks (as ImuStep fills them): the
 // ESKF's covariance propagation at IMU rate is made of these. X has the rows δp, δv, δθ; Y has the rows
 // δbg, δba, δg. MulA(J, X) = A·X; MulBG(J, Y, with_gravity) = [B G]·Y (G's part only if with_gravity).
-template <int N>
-Eigen::Matrix<double, 9, N> MulA(const ImuStepJacobians& J, const Eigen::Matrix<double, 9, N>& X) {
+// X and Y may be blocks of a larger matrix (no copy is made).
+template <int N, typename Derived>
+Eigen::Matrix<double, 9, N> MulA(const ImuStepJacobians& J, const Eigen::MatrixBase<Derived>& X) {
   const auto Xv = X.template middleRows<3>(3);
   const auto Xt = X.template middleRows<3>(6);
   Eigen::Matrix<double, 9, N> out;
@@ -59,8 +60,8 @@ Eigen::Matrix<double, 9, N> MulA(const ImuStepJacobians& J, const Eigen::Matrix<
   return out;
 }
 
-template <int N>
-Eigen::Matrix<double, 9, N> MulBG(const ImuStepJacobians& J, const Eigen::Matrix<double, 9, N>& Y, bool with_gravity) {
+template <int N, typename Derived>
+Eigen::Matrix<double, 9, N> MulBG(const ImuStepJacobians& J, const Eigen::MatrixBase<Derived>& Y, bool with_gravity) {
   const auto Yba = Y.template middleRows<3>(3);
   Eigen::Matrix<double, 9, N> out;
   out.template middleRows<3>(0) = J.B.template block<3, 3>(0, 3).lazyProduct(Yba);
@@ -71,6 +72,23 @@ Eigen::Matrix<double, 9, N> MulBG(const ImuStepJacobians& J, const Eigen::Matrix
     out.template middleRows<3>(3) += J.G(3, 0) * Y.template middleRows<3>(6);
   }
   return out;
+}
+
+// P += B·diag(q)·Bᵀ, the sensor noise over the step (q: the variances of [ηg; ηa], e.g. ImuDiscreteNoise's
+// diagonal), from B's three non-zero blocks: the δp and δv rows take ηa, the δθ rows ηg. P: 9×9, rows and
+// columns δp, δv, δθ (a block of a larger matrix is fine).
+template <typename Derived>
+void AddDrivingNoise(const ImuStepJacobians& J, const Vec6& q, const Eigen::MatrixBase<Derived>& P_out) {
+  auto& P = const_cast<Eigen::MatrixBase<Derived>&>(P_out);  // Eigen's idiom for writable block arguments
+  const auto Bpa = J.B.template block<3, 3>(0, 3), Bva = J.B.template block<3, 3>(3, 3);
+  const auto Btg = J.B.template block<3, 3>(6, 0);
+  const Mat3 BpaQ = Bpa * q.tail<3>().asDiagonal(), BvaQ = Bva * q.tail<3>().asDiagonal();
+  const Mat3 Qpv = BpaQ.lazyProduct(Bva.transpose());
+  P.template block<3, 3>(0, 0) += BpaQ.lazyProduct(Bpa.transpose());
+  P.template block<3, 3>(0, 3) += Qpv;
+  P.template block<3, 3>(3, 0) += Qpv.transpose();
+  P.template block<3, 3>(3, 3) += BvaQ.lazyProduct(Bva.transpose());
+  P.template block<3, 3>(6, 6) += (Btg * q.head<3>().asDiagonal()).lazyProduct(Btg.transpose());
 }
 
 // The rate and specific force to hold between two consecutive samples: their mean. Second-order accurate

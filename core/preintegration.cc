@@ -61,8 +61,8 @@ void Preintegration::Step(const Sample& s) {
   Q.diagonal().tail<3>().array() += s.held_acc_sigma * s.held_acc_sigma;
   // The kernel's structured products (MulA, MulBG): A and B are mostly zero and identity blocks.
   const Mat9 A_cov = MulA<9>(J, cov_);
-  const Eigen::Matrix<double, 9, 6> BQ = J.B.lazyProduct(Q);
-  cov_ = MulA<9>(J, Mat9(A_cov.transpose())).transpose() + BQ.lazyProduct(J.B.transpose());
+  cov_ = MulA<9>(J, A_cov.transpose()).transpose();
+  AddDrivingNoise(J, Q.diagonal(), cov_);
   if (s.held_acc_sigma > 0.0) AddWhiteAcceleration(s.held_acc_sigma, s.dt);
   J_bias_ = MulA<6>(J, J_bias_) + J.B;
   delta_.dq = y.q;

@@ -143,21 +143,16 @@ void Eskf::PropagateCovariance(const ImuStepJacobians& J, double dt) {
   using MatAA = Eigen::Matrix<double, kA, kA>;
   using MatAB = Eigen::Matrix<double, kA, kB>;
   const bool with_g = options_.eskf.estimate_gravity;
-  const MatAA Paa = P_.topLeftCorner<kA, kA>();
-  const MatAB Pab = P_.topRightCorner<kA, kB>();
-  const Eigen::Matrix<double, kD, kA> PbaD = P_.block<kD, kA>(kA, 0);
-  const Eigen::Matrix<double, kD, kB> PbbD = P_.block<kD, kB>(kA, kA);
-  const MatAB M = MulA<kB>(J, Pab) + MulBG<kB>(J, PbbD, with_g);
-  const MatAA M1 = MulA<kA>(J, Paa) + MulBG<kA>(J, PbaD, with_g);
-  const Eigen::Matrix<double, kD, kA> MtC = M.leftCols<kD>().transpose();  // driving rows of Mᵀ
-  P_.topLeftCorner<kA, kA>() = (MulA<kA>(J, MatAA(M1.transpose())) + MulBG<kA>(J, MtC, with_g)).transpose();
+  const MatAB M = MulA<kB>(J, P_.topRightCorner<kA, kB>()) + MulBG<kB>(J, P_.block<kD, kB>(kA, kA), with_g);
+  const MatAA M1 = MulA<kA>(J, P_.topLeftCorner<kA, kA>()) + MulBG<kA>(J, P_.block<kD, kA>(kA, 0), with_g);
+  P_.topLeftCorner<kA, kA>() =
+      (MulA<kA>(J, M1.transpose()) + MulBG<kA>(J, M.leftCols<kD>().transpose(), with_g)).transpose();
   P_.topRightCorner<kA, kB>() = M;
   P_.bottomLeftCorner<kB, kA>() = M.transpose();
 
   // Process noise: sensor white noise through B, bias and scale random walks.
   const Mat6 Qn = ImuDiscreteNoise(options_.imu.gyro_noise_density, options_.imu.acc_noise_density, dt);
-  const Eigen::Matrix<double, kA, 6> BQ = J.B.lazyProduct(Qn);
-  P_.topLeftCorner<kA, kA>() += BQ.lazyProduct(J.B.transpose());
+  AddDrivingNoise(J, Qn.diagonal(), P_.topLeftCorner<kA, kA>());
   AddRandomWalks(dt);
 }
 

@@ -69,6 +69,18 @@ TEST_F(ImuKernelTest, StructuredProductsEqualDenseOnes) {
   const Eigen::Matrix<double, 9, 7> with_g = J.B * Y.topRows<6>() + J.G * Y.bottomRows<3>();
   EXPECT_LT((MulBG<7>(J, Y, true) - with_g).cwiseAbs().maxCoeff(), 1e-14);
   EXPECT_LT((MulBG<7>(J, Y, false) - J.B * Y.topRows<6>()).cwiseAbs().maxCoeff(), 1e-14);
+  // On a block of a larger matrix, without a copy.
+  Eigen::Matrix<double, 12, 7> big = Eigen::Matrix<double, 12, 7>::Random();
+  EXPECT_LT((MulA<7>(J, big.middleRows<9>(2)) - J.A * big.middleRows<9>(2)).cwiseAbs().maxCoeff(), 1e-14);
+  // The sensor noise B·diag(q)·Bᵀ, added into a block.
+  const Vec6 q = Vec6::Random().cwiseAbs();
+  Eigen::Matrix<double, 11, 11> P = Eigen::Matrix<double, 11, 11>::Random();
+  const Eigen::Matrix<double, 11, 11> P0 = P;
+  AddDrivingNoise(J, q, P.block<9, 9>(1, 2));
+  const Mat9 dense = J.B * q.asDiagonal() * J.B.transpose();
+  EXPECT_LT((P.block<9, 9>(1, 2) - P0.block<9, 9>(1, 2) - dense).cwiseAbs().maxCoeff(), 1e-14);
+  P.block<9, 9>(1, 2) = P0.block<9, 9>(1, 2);
+  EXPECT_EQ(P, P0);  // nothing outside the block
 }
 
 TEST(ImuDiscreteNoise, ScalesWithRate) {

@@ -196,23 +196,17 @@ Anchor Smoother::PartialAt(double t) {
 
 void Smoother::UpdateNewestCovariance(MatX* oldest_cov) {
   const size_t n = window_.size();
-  std::vector<size_t> which;
-  if (oldest_cov != nullptr && n > 2) which.push_back(0);
-  if (n >= 2) which.push_back(n - 2);
-  which.push_back(n - 1);
-  MatX joint;
-  if (!KeyframesCovariance(window_, which, &joint)) return;  // keep the last good one
-  const int per = static_cast<int>(joint.rows()) / static_cast<int>(which.size());
-  const int m = static_cast<int>(which.size());
-  newest_cov_ = joint.bottomRightCorner(per, per);
+  MatX trailing;
+  // On failure, the last good ones stay.
+  if (!WindowCovariances(window_, n >= 2 ? 2 : 1, &trailing, n > 2 ? oldest_cov : nullptr)) return;
+  const int per = static_cast<int>(trailing.rows()) / (n >= 2 ? 2 : 1);
+  newest_cov_ = trailing.bottomRightCorner(per, per);
   newest_cov_id_ = window_.back().id;
   if (n >= 2) {
-    newest_two_cov_ = joint.bottomRightCorner(2 * per, 2 * per);
+    newest_two_cov_ = trailing;
   } else {
     newest_two_cov_.resize(0, 0);
   }
-  if (oldest_cov != nullptr) *oldest_cov = joint.topLeftCorner(per, per);
-  (void)m;
 }
 
 void Smoother::RelievePrior(double factor) {

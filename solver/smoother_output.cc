@@ -114,31 +114,67 @@ bool LeadingCovariance(ceres::Problem* problem, const std::vector<double*>& bloc
   return cov->allFinite();
 }
 
-bool KeyframesCovariance(KeyframeStore& store, const std::vector<size_t>& keyframes, MatX* cov) {
+bool WindowCovariances(KeyframeStore& store, int trailing, MatX* trailing_cov, MatX* oldest_cov) {
   ceres::Problem::EvaluateOptions eo;
   eo.parameter_blocks = store.EstimatedBlocks();
   ceres::CRSMatrix J;
   if (!store.problem()->Evaluate(eo, nullptr, nullptr, nullptr, &J)) return false;
-  int per_keyframe = 0;
-  for (BlockType t : store.EstimatedTypes()) per_keyframe += SpecOf(t).tangent_size;
-  if (J.num_cols != per_keyframe * static_cast<int>(store.size())) return false;
+  int per = 0;
+  for (BlockType t : store.EstimatedTypes()) per += SpecOf(t).tangent_size;
+  const int n = per * static_cast<int>(store.size());
+  trailing = std::min(trailing, static_cast<int>(store.size()));
+  if (J.num_cols != n || trailing < 1) return false;
   const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor, int>> Js(
       J.num_rows, J.num_cols, static_cast<Eigen::Index>(J.values.size()), J.rows.data(), J.cols.data(),
       J.values.data());
   const SpMat H = SpMat(Js.transpose()) * Js;
-  std::vector<int> columns;
-  for (size_t k : keyframes) {
-    for (int i = 0; i < per_keyframe; ++i) columns.push_back(static_cast<int>(k) * per_keyframe + i);
+  const int t = trailing * per;
+  const auto symmetric = [](const MatX& c) { return MatX(0.5 * (c + c.transpose())); };
+  const auto positive = [](const MatX& c) { return c.allFinite() && (c.diagonal().array() > 0.0).all(); };
+  {
+    // H = L·D·Lᵀ in the natural (time) order, L unit lower triangular: H⁻¹ = L⁻ᵀ·D⁻¹·L⁻¹ with L⁻¹ lower
+    // triangular too, so the trailing block of H⁻¹ needs only the trailing blocks of L and D:
+    // (H⁻¹)_TT = L_TT⁻ᵀ·D_T⁻¹·L_TT⁻¹. A t×t dense inverse instead of t solves through the whole window.
+    // (Moving the oldest keyframe into the trailing block too was measured no faster: the fill it makes
+    // costs what its solves cost.)
+    const Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(H);
+    if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > 0.0).all()) {
+      const MatX L_tt = ldlt.matrixL().nestedExpression().bottomRightCorner(t, t).toDense();
+      const MatX W = L_tt.triangularView<Eigen::UnitLower>().solve(MatX::Identity(t, t));
+      const MatX C = W.transpose() * ldlt.vectorD().tail(t).cwiseInverse().asDiagonal() * W;
+      bool ok = positive(C);
+      MatX C0;
+      if (ok && oldest_cov != nullptr) {
+        MatX E = MatX::Zero(n, per);
+        E.topRows(per).setIdentity();
+        C0 = ldlt.solve(E).topRows(per);
+        ok = ldlt.info() == Eigen::Success && positive(C0);
+      }
+      if (ok) {
+        *trailing_cov = symmetric(C);
+        if (oldest_cov != nullptr) *oldest_cov = symmetric(C0);
+        return true;
+      }
+    }
   }
-  const int m = static_cast<int>(columns.size());
+  // An ill-conditioned window (see InverseColumns): the guarded column solves.
+  std::vector<int> columns;
+  if (oldest_cov != nullptr) {
+    for (int i = 0; i < per; ++i) columns.push_back(i);
+  }
+  for (int i = n - t; i < n; ++i) columns.push_back(i);
   MatX C;
   if (!InverseColumns(H, columns, &C)) return false;
-  cov->resize(m, m);
+  const int m = static_cast<int>(columns.size());
+  MatX joint(m, m);
   for (int i = 0; i < m; ++i) {
-    for (int j = 0; j < m; ++j) (*cov)(i, j) = C(columns[i], j);
+    for (int j = 0; j < m; ++j) joint(i, j) = C(columns[i], j);
   }
-  *cov = 0.5 * (*cov + cov->transpose());
-  return cov->allFinite();
+  joint = symmetric(joint);
+  if (!joint.allFinite()) return false;
+  *trailing_cov = joint.bottomRightCorner(t, t);
+  if (oldest_cov != nullptr) *oldest_cov = joint.topLeftCorner(per, per);
+  return true;
 }
 
 Mat15 NavCovariance(const std::vector<BlockType>& types, const MatX& block_cov) {

@@ -22,9 +22,10 @@ bool LeadingCovariance(ceres::Problem* problem, const std::vector<double*>& bloc
 // Covariance of the oldest keyframe of the window, from all the information in the window.
 bool OldestCovariance(KeyframeStore& store, Mat15* cov);
 
-// Joint covariance of the estimated blocks of some keyframes of the window (indices, 0 = oldest), in
-// KeyframeStore::EstimatedTypes order, keyframe after keyframe, from all the information in the window.
-bool KeyframesCovariance(KeyframeStore& store, const std::vector<size_t>& keyframes, MatX* cov);
+// Covariances of the estimated blocks (KeyframeStore::EstimatedTypes order) from all the information in the
+// window: of the newest `trailing` keyframes jointly (keyframe after keyframe), and, when oldest_cov is not
+// null, of the oldest keyframe. False if the problem cannot be evaluated or H is not finite.
+bool WindowCovariances(KeyframeStore& store, int trailing, MatX* trailing_cov, MatX* oldest_cov);
 // The same in NavState tangent order (15) for one keyframe's block-order covariance (scale left out).
 Mat15 NavCovariance(const std::vector<BlockType>& types, const MatX& block_cov);
 

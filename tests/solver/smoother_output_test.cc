@@ -40,6 +40,39 @@ TEST(SmootherOutput, OldestCovarianceIsTheDenseInverseOfTheWindowInformation) {
   }
 }
 
+// The newest keyframes' joint covariance comes from the trailing blocks of the LDLᵀ factor alone, the
+// oldest's from column solves: both equal the dense inverse of the window's information.
+TEST(SmootherOutput, WindowCovariancesAreBlocksOfTheDenseInverse) {
+  for (bool estimate_scale : {false, true}) {
+    test::TestWindow w(5, estimate_scale);
+    MatX trailing, oldest;
+    ASSERT_TRUE(WindowCovariances(w.store, 2, &trailing, &oldest));
+    const MatX J = test::DenseJacobian(w.problem.get(), w.store.EstimatedBlocks());
+    const MatX C = (J.transpose() * J).inverse();
+    const int n = static_cast<int>(C.rows()), per = n / 5;
+    ASSERT_EQ(trailing.rows(), 2 * per);
+    ASSERT_EQ(oldest.rows(), per);
+    const MatX want_trailing = C.bottomRightCorner(2 * per, 2 * per), want_oldest = C.topLeftCorner(per, per);
+    for (int i = 0; i < 2 * per; ++i) {
+      for (int j = 0; j < 2 * per; ++j) {
+        EXPECT_NEAR(trailing(i, j), want_trailing(i, j), 1e-7 * std::sqrt(want_trailing(i, i) * want_trailing(j, j)))
+            << i << "," << j;
+      }
+    }
+    for (int i = 0; i < per; ++i) {
+      for (int j = 0; j < per; ++j) {
+        EXPECT_NEAR(oldest(i, j), want_oldest(i, j), 1e-7 * std::sqrt(want_oldest(i, i) * want_oldest(j, j)))
+            << i << "," << j;
+      }
+    }
+    // Without the oldest: the trailing block alone, the same.
+    MatX trailing_only;
+    ASSERT_TRUE(WindowCovariances(w.store, 1, &trailing_only, nullptr));
+    EXPECT_LT((trailing_only - trailing.bottomRightCorner(per, per)).cwiseAbs().maxCoeff(),
+              1e-9 * trailing.diagonal().cwiseAbs().maxCoeff());
+  }
+}
+
 TEST(SmootherOutput, EstimateOfTurnsTheAttitudeSigmaIntoWorldAxes) {
   Keyframe kf;
   NavState x;

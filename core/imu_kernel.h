@@ -74,6 +74,47 @@ Eigen::Matrix<double, 9, N> MulBG(const ImuStepJacobians& J, const Eigen::Matrix
   return out;
 }
 
+// The same products transposed: MulAT(J, XT) = XT·Aᵀ = (A·X)ᵀ and MulBGT(J, YT, with_gravity) = YT·[B G]ᵀ,
+// with XT's columns δp, δv, δθ and YT's δbg, δba, δg. Each output column is a weighted sum of a few of XT's
+// columns, which Eigen vectorises down the rows (A·X's 3-row blocks do not vectorise). For a symmetric
+// covariance XT is its own block: the ESKF's propagation uses these. Same sums in the same order as MulA.
+template <int N, typename Derived>
+Eigen::Matrix<double, N, 9> MulAT(const ImuStepJacobians& J, const Eigen::MatrixBase<Derived>& XT) {
+  const Mat9& A = J.A;
+  Eigen::Matrix<double, N, 9> out;
+  for (int c = 0; c < 3; ++c) {
+    const auto t_sum = [&](int row) {
+      return A(row, 6) * XT.col(6) + A(row, 7) * XT.col(7) + A(row, 8) * XT.col(8);
+    };
+    if (J.coriolis) {
+      out.col(c) = XT.col(c) + (A(c, 3) * XT.col(3) + A(c, 4) * XT.col(4) + A(c, 5) * XT.col(5)) + t_sum(c);
+      out.col(3 + c) = (A(3 + c, 3) * XT.col(3) + A(3 + c, 4) * XT.col(4) + A(3 + c, 5) * XT.col(5)) + t_sum(3 + c);
+    } else {  // A's δv blocks are I·dt and I
+      out.col(c) = XT.col(c) + A(0, 3) * XT.col(3 + c) + t_sum(c);
+      out.col(3 + c) = XT.col(3 + c) + t_sum(3 + c);
+    }
+    out.col(6 + c) = t_sum(6 + c);
+  }
+  return out;
+}
+
+template <int N, typename Derived>
+Eigen::Matrix<double, N, 9> MulBGT(const ImuStepJacobians& J, const Eigen::MatrixBase<Derived>& YT,
+                                   bool with_gravity) {
+  const auto& B = J.B;
+  Eigen::Matrix<double, N, 9> out;
+  for (int c = 0; c < 3; ++c) {
+    out.col(c) = B(c, 3) * YT.col(3) + B(c, 4) * YT.col(4) + B(c, 5) * YT.col(5);
+    out.col(3 + c) = B(3 + c, 3) * YT.col(3) + B(3 + c, 4) * YT.col(4) + B(3 + c, 5) * YT.col(5);
+    out.col(6 + c) = B(6 + c, 0) * YT.col(0) + B(6 + c, 1) * YT.col(1) + B(6 + c, 2) * YT.col(2);
+    if (with_gravity) {
+      out.col(c) += J.G(0, 0) * YT.col(6 + c);
+      out.col(3 + c) += J.G(3, 0) * YT.col(6 + c);
+    }
+  }
+  return out;
+}
+
 // P += B·diag(q)·Bᵀ, the sensor noise over the step (q: the variances of [ηg; ηa], e.g. ImuDiscreteNoise's
 // diagonal), from B's three non-zero blocks: the δp and δv rows take ηa, the δθ rows ηg. P: 9×9, rows and
 // columns δp, δv, δθ (a block of a larger matrix is fine).

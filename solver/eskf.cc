@@ -136,19 +136,20 @@ void Eskf::CoastCovariance(double dt) {
 
 void Eskf::PropagateCovariance(const ImuStepJacobians& J, double dt) {
   // F = [[A, C], [0, I]] with the kinematic block a = (δp, δv, δθ) and b = (δbg, δba, δg, δs), C = [B G 0]:
-  // P'aa = A·Paa·Aᵀ + A·Pab·Cᵀ + C·Pba·Aᵀ + C·Pbb·Cᵀ = (A·M1ᵀ + C·Mᵀ)ᵀ with M1 = A·Paa + C·Pba and
-  // M = P'ab = A·Pab + C·Pbb. The products skip A's and C's zero and identity blocks (MulA, MulBG). C has
-  // columns for the driving blocks (δbg, δba, δg) only, so Pba and Pbb enter through their driving rows.
+  // P'aa = A·Paa·Aᵀ + A·Pab·Cᵀ + C·Pba·Aᵀ + C·Pbb·Cᵀ = M1·Aᵀ + M·Cᵀ with M1 = A·Paa + C·Pba and
+  // M = P'ab = A·Pab + C·Pbb. The products skip A's and C's zero and identity blocks, and run transposed
+  // (MulAT, MulBGT: P is symmetric, so Pabᵀ = Pba and Pbbᵀ = Pbb are P's own blocks). C has columns for the
+  // driving blocks (δbg, δba, δg) only, so Pba and Pbb enter through their driving rows.
   constexpr int kA = eskf::kKinematicDim, kB = eskf::kNonKinematicDim, kD = eskf::kDrivingDim;
   using MatAA = Eigen::Matrix<double, kA, kA>;
-  using MatAB = Eigen::Matrix<double, kA, kB>;
   const bool with_g = options_.eskf.estimate_gravity;
-  const MatAB M = MulA<kB>(J, P_.topRightCorner<kA, kB>()) + MulBG<kB>(J, P_.block<kD, kB>(kA, kA), with_g);
-  const MatAA M1 = MulA<kA>(J, P_.topLeftCorner<kA, kA>()) + MulBG<kA>(J, P_.block<kD, kA>(kA, 0), with_g);
-  P_.topLeftCorner<kA, kA>() =
-      (MulA<kA>(J, M1.transpose()) + MulBG<kA>(J, M.leftCols<kD>().transpose(), with_g)).transpose();
-  P_.topRightCorner<kA, kB>() = M;
-  P_.bottomLeftCorner<kB, kA>() = M.transpose();
+  const Eigen::Matrix<double, kB, kA> Mt =
+      MulAT<kB>(J, P_.bottomLeftCorner<kB, kA>()) + MulBGT<kB>(J, P_.block<kB, kD>(kA, kA), with_g);
+  const MatAA M1 =
+      (MulAT<kA>(J, P_.topLeftCorner<kA, kA>()) + MulBGT<kA>(J, P_.block<kA, kD>(0, kA), with_g)).transpose();
+  P_.topRightCorner<kA, kB>() = Mt.transpose();
+  P_.bottomLeftCorner<kB, kA>() = Mt;
+  P_.topLeftCorner<kA, kA>() = MulAT<kA>(J, M1) + MulBGT<kA>(J, P_.block<kA, kD>(0, kA), with_g);
 
   // Process noise: sensor white noise through B, bias and scale random walks.
   const Mat6 Qn = ImuDiscreteNoise(options_.imu.gyro_noise_density, options_.imu.acc_noise_density, dt);

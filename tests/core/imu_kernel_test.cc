@@ -69,6 +69,11 @@ TEST_F(ImuKernelTest, StructuredProductsEqualDenseOnes) {
   const Eigen::Matrix<double, 9, 7> with_g = J.B * Y.topRows<6>() + J.G * Y.bottomRows<3>();
   EXPECT_LT((MulBG<7>(J, Y, true) - with_g).cwiseAbs().maxCoeff(), 1e-14);
   EXPECT_LT((MulBG<7>(J, Y, false) - J.B * Y.topRows<6>()).cwiseAbs().maxCoeff(), 1e-14);
+  // Transposed: XT·Aᵀ and YT·[B G]ᵀ.
+  EXPECT_LT((MulAT<7>(J, X.transpose()) - X.transpose() * J.A.transpose()).cwiseAbs().maxCoeff(), 1e-14);
+  EXPECT_LT((MulBGT<7>(J, Y.transpose(), true) - with_g.transpose()).cwiseAbs().maxCoeff(), 1e-14);
+  EXPECT_LT((MulBGT<7>(J, Y.transpose(), false) - (J.B * Y.topRows<6>()).transpose()).cwiseAbs().maxCoeff(),
+            1e-14);
   // On a block of a larger matrix, without a copy.
   Eigen::Matrix<double, 12, 7> big = Eigen::Matrix<double, 12, 7>::Random();
   EXPECT_LT((MulA<7>(J, big.middleRows<9>(2)) - J.A * big.middleRows<9>(2)).cwiseAbs().maxCoeff(), 1e-14);
@@ -118,6 +123,7 @@ TEST_F(ImuKernelTest, EarthRotationJacobiansMatchNumeric) {
   EXPECT_LT((test::NumericJacobian<9, 6>(fb) - J.B).cwiseAbs().maxCoeff(), 1e-8);
   const Eigen::Matrix<double, 9, 7> X = Eigen::Matrix<double, 9, 7>::Random();
   EXPECT_LT((MulA<7>(J, X) - J.A * X).cwiseAbs().maxCoeff(), 1e-14);
+  EXPECT_LT((MulAT<7>(J, X.transpose()) - X.transpose() * J.A.transpose()).cwiseAbs().maxCoeff(), 1e-14);
 }
 
 TEST_F(ImuKernelTest, EarthRotationTurnsTheWorldFrame) {

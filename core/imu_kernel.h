@@ -37,9 +37,10 @@ Kinematics ImuStep(const Kinematics& x, const Vec3& omega, const Vec3& acc, cons
                    ImuStepJacobians* J = nullptr, const Vec3& earth_rate_w = Vec3::Zero());
 
 // Products with the step Jacobians that skip their zero and identity blocks (as ImuStep fills them): the
-// ESKF's covariance propagation at IMU rate is made of these. X has the rows δp, δv, δθ; Y has the rows
-// δbg, δba, δg. MulA(J, X) = A·X; MulBG(J, Y, with_gravity) = [B G]·Y (G's part only if with_gravity).
-// X and Y may be blocks of a larger matrix (no copy is made).
+// preintegration's covariance and the RTS pass's transitions are made of these (the ESKF's propagation of
+// their transposes, below). X has the rows δp, δv, δθ; Y has the rows δbg, δba, δg. MulA(J, X) = A·X;
+// MulBG(J, Y, with_gravity) = [B G]·Y (G's part only if with_gravity). X and Y may be blocks of a larger
+// matrix (no copy is made).
 template <int N, typename Derived>
 Eigen::Matrix<double, 9, N> MulA(const ImuStepJacobians& J, const Eigen::MatrixBase<Derived>& X) {
   const auto Xv = X.template middleRows<3>(3);

@@ -50,13 +50,7 @@ StandstillDetector::StandstillDetector(const StandstillOptions& options, double 
 void StandstillDetector::AddImu(const ImuSample& imu) {
   t_ = imu.t;
   imu_.push_back(imu);
-  const CumulativeSums d = Deviations(imu);
-  CumulativeSums c = cum_.empty() ? cum_before_ : cum_.back();
-  c.g += d.g;
-  c.a += d.a;
-  cum_.push_back(c);
-  sq_g_ += d.g.cwiseAbs2();
-  sq_a_ += d.a.cwiseAbs2();
+  AppendSums(imu);
   while (!imu_.empty() && t_ - imu_.front().t > options_.window) {
     const CumulativeSums out = Deviations(imu_.front());
     sq_g_ -= out.g.cwiseAbs2();
@@ -86,6 +80,16 @@ StandstillDetector::CumulativeSums StandstillDetector::Deviations(const ImuSampl
   return {s.gyro - ref_g_, s.acc - ref_a_};
 }
 
+void StandstillDetector::AppendSums(const ImuSample& s) {
+  const CumulativeSums d = Deviations(s);
+  CumulativeSums c = cum_.empty() ? cum_before_ : cum_.back();
+  c.g += d.g;
+  c.a += d.a;
+  cum_.push_back(c);
+  sq_g_ += d.g.cwiseAbs2();
+  sq_a_ += d.a.cwiseAbs2();
+}
+
 void StandstillDetector::Rebase() {
   // Deviations about a sample of the window keep the variance accurate next to |g|.
   ref_g_ = imu_.empty() ? Vec3::Zero() : imu_.front().gyro;
@@ -95,15 +99,7 @@ void StandstillDetector::Rebase() {
   sq_g_.setZero();
   sq_a_.setZero();
   removed_ = 0;
-  CumulativeSums c;
-  for (const ImuSample& s : imu_) {
-    const CumulativeSums d = Deviations(s);
-    c.g += d.g;
-    c.a += d.a;
-    cum_.push_back(c);
-    sq_g_ += d.g.cwiseAbs2();
-    sq_a_ += d.a.cwiseAbs2();
-  }
+  for (const ImuSample& s : imu_) AppendSums(s);
 }
 
 bool StandstillDetector::WindowQuiet() const {

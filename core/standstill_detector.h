@@ -76,6 +76,7 @@ class StandstillDetector {
   };
   void Rebase();
   CumulativeSums Deviations(const ImuSample& s) const;
+  void AppendSums(const ImuSample& s);  // the newest sample of imu_ into cum_ and the squared sums
   // The GNSS's verdict over the quiet stretch: kStanding, kMoving, kUndecided, or kQuietUnwitnessed when
   // there is nothing to judge by; *witness says which record type decided.
   State GnssVerdict(Witness* witness) const;

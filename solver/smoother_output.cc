@@ -102,8 +102,8 @@ SpMat Information(const ceres::CRSMatrix& J) {
 
 }  // namespace
 
-// The window is a chain, so H is banded: a sparse product and a sparse LDLᵀ in the natural (time) order
-// cost a few hundred µs where dense ones cost milliseconds per keyframe.
+// The window is a chain, so H is banded: a sparse JᵀJ and a sparse LDLᵀ in the natural (time) order cost a
+// few hundred µs where dense ones cost milliseconds per keyframe.
 bool LeadingCovariance(ceres::Problem* problem, const std::vector<double*>& blocks, const std::vector<int>& nav_index,
                        Mat15* cov) {
   ceres::Problem::EvaluateOptions eo;

@@ -1,10 +1,10 @@
 // Chord factor: the non-holonomic constraint between keyframes i and j (core/odometry_model.h): the rear-axle
-// centre's chord points along the body x axis halfway between the two attitudes.
+// centre's chord points along the path its body x axis traced over the interval.
 //
 // Parameter blocks: pose_i (7), pose_j (7) (factors/pose_manifold.h).
 // Residual (2):
-//   r = ((R_mᵀ·(a_j − a_i)).y, (R_mᵀ·(a_j − a_i)).z) / (Δt·σ)   (unitless; σ in m/s, the mean lateral and
-//                                                                vertical speed's 1-σ over the interval)
+//   r = N_i·R_iᵀ·(a_j − a_i) / (Δt·σ)   (unitless; N_i the two directions across the path, σ in m/s, the mean
+//                                        lateral and vertical speed's 1-σ over the interval)
 // The raw residual is ChordModel::Residual.
 #pragma once
 
@@ -20,8 +20,10 @@ class ChordFactor {
  public:
   static constexpr int kResidualDim = ChordModel::kResidualDim;
 
-  // dt: t_j − t_i (s, > 0); sigma (m/s, > 0); lever_b: rear-axle centre in b.
-  ChordFactor(double dt, double sigma, const Vec3& lever_b) : dt_(dt), inv_sigma_(1.0 / sigma), lever_b_(lever_b) {}
+  // dt: t_j − t_i (s, > 0); sigma (m/s, > 0); lever_b: rear-axle centre in b; path_i: the axle's path P_i
+  // in the body frame at i (m; only its direction counts).
+  ChordFactor(double dt, double sigma, const Vec3& lever_b, const Vec3& path_i)
+      : dt_(dt), inv_sigma_(1.0 / sigma), lever_b_(lever_b), across_i_(ChordModel::Basis(path_i)) {}
 
   template <typename T>
   bool operator()(const T* pose_i, const T* pose_j, T* residual) const {
@@ -29,17 +31,18 @@ class ChordFactor {
     out = ChordModel::Residual<T>(Eigen::Matrix<T, 3, 1>(PosePosition(pose_i)),
                                   Eigen::Quaternion<T>(PoseRotation(pose_i)),
                                   Eigen::Matrix<T, 3, 1>(PosePosition(pose_j)),
-                                  Eigen::Quaternion<T>(PoseRotation(pose_j)), lever_b_, dt_) *
+                                  Eigen::Quaternion<T>(PoseRotation(pose_j)), lever_b_, across_i_, dt_) *
           T(inv_sigma_);
     return true;
   }
 
   // AutoDiffCostFunction<ChordFactor, 2, 7, 7>.
-  static ceres::CostFunction* Create(double dt, double sigma, const Vec3& lever_b);
+  static ceres::CostFunction* Create(double dt, double sigma, const Vec3& lever_b, const Vec3& path_i);
 
  private:
   double dt_, inv_sigma_;
   Vec3 lever_b_;
+  Eigen::Matrix<double, 2, 3> across_i_;
 };
 
 }  // namespace gins

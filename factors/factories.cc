@@ -90,10 +90,10 @@ ceres::CostFunction* OdometerFactor::Create(const Vec3& displacement_i, double s
       new OdometerFactor(displacement_i, sigma, lever_b));
 }
 
-ceres::CostFunction* ChordFactor::Create(double dt, double sigma, const Vec3& lever_b) {
+ceres::CostFunction* ChordFactor::Create(double dt, double sigma, const Vec3& lever_b, const Vec3& path_i) {
   CHECK(dt > 0.0 && sigma > 0.0) << "ChordFactor: dt and σ must be > 0";
   return new ceres::AutoDiffCostFunction<ChordFactor, 2, pose::kAmbient, pose::kAmbient>(
-      new ChordFactor(dt, sigma, lever_b));
+      new ChordFactor(dt, sigma, lever_b, path_i));
 }
 
 ceres::CostFunction* WheelYawFactor::Create(double yaw_change, double sigma) {

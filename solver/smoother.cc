@@ -102,6 +102,10 @@ void Smoother::IntegrateTo(double t, const ImuSample* held) {
   const double dt = t - t_now_;
   if (dt <= 0.0) return;
   if (held == nullptr && last_imu_) held = &*last_imu_;
+  ImuStepView step;
+  step.dt = dt;
+  step.dR_begin = preint_->delta().dq;
+  step.v_b_begin = pred_.q_wb.conjugate() * pred_.v_w;
   ImuSample coast;
   // Across an IMU gap (judged from the newest sample, whatever t_now_ is), and over a step no sample covers
   // (a fix after the initialisation, before the first sample): no rotation and no acceleration, from the
@@ -128,6 +132,10 @@ void Smoother::IntegrateTo(double t, const ImuSample* held) {
   g_w_ = earth_.Gravity(pred_.p_wb);
   pred_.t = t;
   t_now_ = t;
+  step.dR_end = preint_->delta().dq;
+  step.v_b_end = pred_.q_wb.conjugate() * pred_.v_w;
+  step.omega_b = held->gyro - pred_.bg;
+  for (auto& attacher : attachers_) attacher->OnImuStep(step);
 }
 
 void Smoother::AddImu(const ImuSample& imu) {

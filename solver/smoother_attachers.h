@@ -44,6 +44,15 @@ struct Prediction {
   MatX cov;
 };
 
+// One IMU step of the preintegration from the newest keyframe (every step, a coast over a gap included):
+// the rotation from that keyframe's body frame to the step's start and end, the predicted body velocity
+// there, and the body rate against w over the step.
+struct ImuStepView {
+  double dt = 0.0;
+  Quat dR_begin, dR_end;
+  Vec3 v_b_begin, v_b_end, omega_b;
+};
+
 // Where a measurement at t attaches: a keyframe, and the IMU preintegrated from it to t (null at its time).
 struct Anchor {
   Keyframe* kf = nullptr;
@@ -83,6 +92,8 @@ class MeasurementAttacher {
   virtual bool OnGvel(const GvelMeasurement& /*m*/, const AttachContext& /*ctx*/) { return false; }
   virtual void OnWheel(const WheelMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
   virtual void OnStandstill(const StandstillMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
+  // An IMU step was integrated from the newest keyframe (before the keyframe it ends at, if any, is made).
+  virtual void OnImuStep(const ImuStepView& /*step*/) {}
   // A keyframe became the newest, with its IMU and random-walk factors.
   virtual void OnKeyframeCreated(Keyframe& /*kf*/, const AttachContext& /*ctx*/) {}
   // The oldest keyframe leaves the window; its factors are gone already.

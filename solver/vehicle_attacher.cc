@@ -87,6 +87,16 @@ void VehicleAttacher::OnWheel(const WheelMeasurement& m, const AttachContext& ct
   Add(&*open_, m, (m.t - from) / m.interval, dR_mid);
 }
 
+void VehicleAttacher::OnImuStep(const ImuStepView& step) {
+  if (!options_.vehicle.nonholonomic) return;
+  // The axle's forward speed at the step's ends, along the body x axis there (trapezoid rule).
+  const Vec3& lever = options_.wheel.lever_b;
+  const Vec3 turn = step.omega_b.cross(lever);
+  path_ += 0.5 * step.dt *
+           ((step.v_b_begin + turn).x() * (step.dR_begin * Vec3::UnitX()) +
+            (step.v_b_end + turn).x() * (step.dR_end * Vec3::UnitX()));
+}
+
 void VehicleAttacher::OnKeyframeCreated(Keyframe& kf, const AttachContext& ctx) {
   const size_t n = ctx.keyframes.size();
   if (n >= 2) {
@@ -94,6 +104,7 @@ void VehicleAttacher::OnKeyframeCreated(Keyframe& kf, const AttachContext& ctx) 
     AttachOdometry(ctx);
     if (options_.vehicle.nonholonomic) AttachChord(ctx.keyframes[n - 2], kf, ctx);
   }
+  path_.setZero();
   if (options_.vehicle.nonholonomic) AttachNonHolonomic(kf, ctx);
   if (open_) {
     closing_ = open_;
@@ -133,7 +144,7 @@ void VehicleAttacher::AttachChord(Keyframe& prev, Keyframe& kf, const AttachCont
   // The constraint's noise is white at vehicle.nhc_rate_hz (as the ESKF applies it): over the interval its
   // mean has the σ of rate·Δt samples averaged.
   const double sigma = options_.vehicle.nhc_sigma / std::sqrt(std::max(1.0, options_.vehicle.nhc_rate * dt));
-  ceres::CostFunction* cost = ChordFactor::Create(dt, sigma, options_.wheel.lever_b);
+  ceres::CostFunction* cost = ChordFactor::Create(dt, sigma, options_.wheel.lever_b, path_);
   const FactorCheck c = CheckFactor(*cost, {prev.block(BlockType::kPose), kf.block(BlockType::kPose)},
                                     {BlockKind::kPose, BlockKind::kPose}, PairCovariance(types, joint, false));
   if (!c.Passes(gate_nhc_)) {
@@ -191,6 +202,7 @@ void VehicleAttacher::AttachOdometry(const AttachContext& ctx) {
 }
 
 void VehicleAttacher::OnWindowRebuilt() {
+  path_.setZero();
   open_.reset();
   closing_.reset();
   closing_t1_.reset();

@@ -2,9 +2,10 @@
 // core/odometry_model.h), every one checked against the window's prediction before it is attached:
 // - the non-holonomic constraint (vehicle.nonholonomic), a constraint of the vehicle whether or not the log
 //   has wheels: at each keyframe (the rear-axle centre's sideways and vertical speed, with the lever arm and
-//   the body rate) and over each interval between keyframes (the axle's chord along the body x axis
-//   halfway between their attitudes: the constraint integrated over the interval, with the σ of the mean
-//   of vehicle.nhc_rate_hz white samples, the information the ESKF's updates at that rate carry);
+//   the body rate) and over each interval between keyframes (the axle's chord along the path its body x
+//   axis traced, from the IMU's attitude and the predicted speed at every step: the constraint integrated
+//   over the interval, with the σ of the mean of vehicle.nhc_rate_hz white samples, the information the
+//   ESKF's updates at that rate carry);
 // - the odometer: every encoder record between two keyframes, integrated into a displacement in the
 //   earlier keyframe's body frame (each record's distance along the preintegrated attitude at its middle; a
 //   record that straddles a keyframe split between the two intervals), compared with the axle's
@@ -25,6 +26,7 @@ class VehicleAttacher final : public MeasurementAttacher {
   explicit VehicleAttacher(const EstimatorOptions& options);
 
   void OnWheel(const WheelMeasurement& m, const AttachContext& ctx) override;
+  void OnImuStep(const ImuStepView& step) override;
   void OnKeyframeCreated(Keyframe& kf, const AttachContext& ctx) override;
   void OnWindowRebuilt() override;
   void AddStats(nlohmann::json* stats) const override;
@@ -51,6 +53,7 @@ class VehicleAttacher final : public MeasurementAttacher {
   std::optional<Accumulator> open_;     // from the newest keyframe to now
   std::optional<Accumulator> closing_;  // the interval before it, until the record that straddles its end
   std::optional<double> closing_t1_;    // that interval's end
+  Vec3 path_ = Vec3::Zero();            // the axle's path P_i from the newest keyframe (core/odometry_model.h)
   MeasurementCounts nhc_counts_, chord_counts_, odometer_counts_, yaw_counts_;
   uint64_t wheel_records_ = 0;
 };

@@ -43,8 +43,8 @@ TEST(VehicleFactorsTest, ZeroOnAnArc) {
   // D sums the encoder steps as vectors, so it is the chord too: what is left is the steps' discretisation.
   EXPECT_LT(std::abs(r1) * 0.01, 1e-5);
   Vec2 r2;
-  ChordFactor(dt, 0.1, kLever)(pi.data(), pj.data(), r2.data());
-  EXPECT_LT(r2.norm(), 1e-9);
+  ChordFactor(dt, 0.1, kLever, D)(pi.data(), pj.data(), r2.data());
+  EXPECT_LT(r2.norm() * 0.1, 1e-5);
   WheelYawFactor(yaw, 0.01)(pi.data(), pj.data(), &scale, &r1);
   EXPECT_LT(std::abs(r1), 1e-9);
   // The IMU, 1.5 m ahead of the axle, slides sideways in the turn; the axle centre does not.
@@ -63,11 +63,54 @@ TEST(VehicleFactorsTest, ZeroOnAnArc) {
   EXPECT_LT(r3.norm(), 1e-9);
 }
 
+// Entering a turn while speeding up (yaw rate and speed both ramp): the axle's chord leaves the body x axis
+// halfway between the two attitudes by more than the constraint's σ, but points along the path the body x
+// axis traced, weighted by the speed (ChordModel), to the integration's accuracy.
+TEST(VehicleFactorsTest, ChordAlongThePathWhenTheTurnTightens) {
+  const double dt = 1.1, v0 = 8.0, accel = 1.5, yaw_accel = 0.6;  // m/s, m/s², rad/s²
+  const int steps = 11000;
+  Vec3 axle = Vec3::Zero(), path = Vec3::Zero();
+  for (int k = 0; k < steps; ++k) {
+    const double t = (k + 0.5) * dt / steps;
+    const Vec3 step = (v0 + accel * t) * dt / steps * (QuatFromYaw(0.5 * yaw_accel * t * t) * Vec3::UnitX());
+    axle += step;
+    path += step;  // the body frame at i is the world's here
+  }
+  const Quat q_j = QuatFromYaw(0.5 * yaw_accel * dt * dt);
+  const test::PoseBlock pi = test::MakePose(-kLever, Quat::Identity());
+  const test::PoseBlock pj = test::MakePose(axle - q_j * kLever, q_j);
+  Vec2 r;
+  ChordFactor(dt, 0.01, kLever, path)(pi.data(), pj.data(), r.data());
+  EXPECT_LT(r.norm(), 1e-3);  // 1e-5 m/s against σ = 0.01 m/s
+  // Against the attitude halfway instead: 0.53 m across the 9.6 m chord, 0.48 m/s on average.
+  const Vec3 halfway = QuatFromYaw(0.25 * yaw_accel * dt * dt) * Vec3::UnitX();
+  ChordFactor(dt, 0.01, kLever, halfway)(pi.data(), pj.data(), r.data());
+  EXPECT_GT(std::abs(r.x()) * 0.01, 0.4);
+}
+
+TEST(VehicleFactorsTest, ChordBasis) {
+  Eigen::Matrix<double, 2, 3> n = ChordModel::Basis(Vec3(3.0, 0.0, 0.0));
+  EXPECT_TRUE(n.row(0).isApprox(Vec3::UnitY().transpose()));
+  EXPECT_TRUE(n.row(1).isApprox(Vec3::UnitZ().transpose()));
+  // A standstill (no path) and reversing (the path behind): the body's own lateral and vertical axes.
+  n = ChordModel::Basis(Vec3(1e-4, 2e-4, 0.0));
+  EXPECT_TRUE(n.row(0).isApprox(Vec3::UnitY().transpose()));
+  n = ChordModel::Basis(Vec3(-2.0, 0.0, 0.0));
+  EXPECT_TRUE(n.row(0).cwiseAbs().isApprox(Vec3::UnitY().transpose()));
+  EXPECT_TRUE(n.row(1).isApprox(Vec3::UnitZ().transpose()));
+  // Any path: two unit rows, orthogonal to each other and to the path; even straight up.
+  for (const Vec3& u : {Vec3(5.0, 1.0, -0.4), Vec3(-0.3, 2.0, 0.5), Vec3(0.01, 0.0, 3.0)}) {
+    n = ChordModel::Basis(u);
+    EXPECT_NEAR((n * n.transpose() - Eigen::Matrix2d::Identity()).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((n * u).norm(), 0.0, 1e-12);
+  }
+}
+
 TEST(VehicleFactorsTest, JacobiansMatchNumeric) {
   std::mt19937 rng(23);
   const PoseManifold m;
   const std::unique_ptr<ceres::CostFunction> odo(OdometerFactor::Create(Vec3(9.8, 0.5, 0.1), 0.02, kLever));
-  const std::unique_ptr<ceres::CostFunction> chord(ChordFactor::Create(0.8, 0.1, kLever));
+  const std::unique_ptr<ceres::CostFunction> chord(ChordFactor::Create(0.8, 0.1, kLever, Vec3(7.9, 0.6, -0.2)));
   const std::unique_ptr<ceres::CostFunction> yaw(WheelYawFactor::Create(0.3, 0.01));
   const std::unique_ptr<ceres::CostFunction> nhc(NhcFactor::Create(0.1, Vec3(0.01, -0.02, 0.3), kLever));
   const std::unique_ptr<ceres::CostFunction> gvel(

@@ -20,7 +20,7 @@ struct EskfOptions {
 struct SmootherOptions {
   int window_size = 10;             // smoother.window_size: keyframes in the window
   double max_keyframe_interval = 1.0;  // smoother.max_keyframe_interval_s
-  double min_keyframe_interval = 0.5;  // smoother.min_keyframe_interval_s: faster GNSS is decimated
+  double min_keyframe_interval = 0.5;  // smoother.min_keyframe_interval_s: faster GNSS makes no keyframe
   std::string linear_solver = "sparse_normal_cholesky";  // smoother.linear_solver: sparse_normal_cholesky | dense_schur
   int max_iterations = 10;          // smoother.max_iterations
   double function_tolerance = 1e-6;  // smoother.function_tolerance: stop when |Δcost|/cost falls below

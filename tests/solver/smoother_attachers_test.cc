@@ -223,5 +223,51 @@ TEST_F(AttacherTest, NonHolonomicConstraintAtEachKeyframeWithOrWithoutWheels) {
   EXPECT_EQ(s["nonholonomic"]["rejected"]["chi2_gate"], 1);
 }
 
+// The chord between two keyframes is checked across the path the IMU traced (OnImuStep): entering a left turn
+// while speeding up, it is used; against a path that went straight on, the same keyframes are rejected.
+TEST_F(AttacherTest, ChordFollowsThePathTheImuTraced) {
+  options_.wheel.enabled = false;
+  VehicleAttacher turned(options_), straight(options_);
+  Keyframe& k0 = Push(0.0, 8.0);
+  turned.OnKeyframeCreated(k0, context_);
+  straight.OnKeyframeCreated(k0, context_);
+  const int n = static_cast<int>(NavIndexOfTangent(store_.EstimatedTypes()).size());
+  two_ = MatX::Identity(2 * n, 2 * n) * 1e-6;
+  const double alpha = 0.6, accel = 1.5, dt = 0.01;  // yaw acceleration rad/s², m/s², IMU step s
+  auto yaw = [&](double t) { return 0.5 * alpha * t * t; };
+  auto speed = [&](double t) { return 8.0 + accel * t; };
+  Vec3 p = Vec3::Zero();
+  for (int k = 0; k < 110; ++k) {
+    const double t0 = k * dt, t1 = t0 + dt;
+    ImuStepView step;
+    step.dt = dt;
+    step.dR_begin = QuatFromYaw(yaw(t0));
+    step.dR_end = QuatFromYaw(yaw(t1));
+    step.v_b_begin = Vec3(speed(t0), 0.0, 0.0);
+    step.v_b_end = Vec3(speed(t1), 0.0, 0.0);
+    step.omega_b = Vec3(0.0, 0.0, alpha * 0.5 * (t0 + t1));
+    turned.OnImuStep(step);
+    step.dR_begin = step.dR_end = Quat::Identity();
+    straight.OnImuStep(step);
+    for (int m = 0; m < 10; ++m) {  // the true path, finer
+      const double t = t0 + (m + 0.5) * dt / 10.0;
+      p += speed(t) * dt / 10.0 * (QuatFromYaw(yaw(t)) * Vec3::UnitX());
+    }
+  }
+  NavState x;
+  x.t = 1.1;
+  x.p_wb = p;
+  x.q_wb = QuatFromYaw(yaw(1.1));
+  x.v_w = x.q_wb * Vec3(speed(1.1), 0.0, 0.0);
+  Keyframe& k1 = store_.Push(store_.Make(1.1, x));
+  auto preint = std::make_shared<Preintegration>(Vec3::Zero(), Vec3::Zero(), 1e-3, 1e-2);
+  preint->Integrate(Vec3(0.0, 0.0, 0.33), Vec3(accel, 0.0, 9.81), 1.1);
+  k1.preint = preint;
+  turned.OnKeyframeCreated(k1, context_);
+  straight.OnKeyframeCreated(k1, context_);
+  EXPECT_EQ(Stats(turned)["nonholonomic_chord"]["used"], 1);
+  EXPECT_EQ(Stats(straight)["nonholonomic_chord"]["rejected"]["chi2_gate"], 1);
+}
+
 }  // namespace
 }  // namespace gins

@@ -68,18 +68,6 @@ ceres::CostFunction* ImuFactor::CreateAutoDiff(std::shared_ptr<const Preintegrat
 namespace {
 
 using Mat93 = Eigen::Matrix<double, 9, 3>;
-using Mat34 = Eigen::Matrix<double, 3, 4>;
-
-// Writes the whitened tangent Jacobian of a pose block (columns δp, δθ) as the ambient one, J_tan·M(q)
-// (see ImuCostFunction in the header): p columns unchanged, q columns J_θ·2·[w·I − [v]×, −v].
-void WritePoseJacobian(const Mat93& J_dp, const Mat93& J_dtheta, const Quat& q, double* out) {
-  Mat34 M;
-  M.leftCols<3>() = 2.0 * (q.w() * Mat3::Identity() - Hat<double>(q.vec()));
-  M.col(3) = -2.0 * q.vec();
-  Eigen::Map<Eigen::Matrix<double, 9, pose::kAmbient, Eigen::RowMajor>> J(out);
-  J.middleCols<3>(pose::kP) = J_dp;
-  J.middleCols<4>(pose::kQ) = J_dtheta * M;
-}
 
 }  // namespace
 
@@ -120,7 +108,7 @@ bool ImuCostFunction::Evaluate(double const* const* parameters, double* residual
   if (jacobians[0] != nullptr) {  // pose_i
     const Mat3 R_ji = t.q_ij.conjugate().toRotationMatrix();
     const Mat93 J_dtheta = S_p * Hat<double>(t.dp_i) + S_v * Hat<double>(t.dv_i) - S_theta_Jr_inv * R_ji;
-    WritePoseJacobian(-J_D, J_dtheta, Quat(q_i), jacobians[0]);
+    WriteAmbientPoseJacobian<9>(-J_D, J_dtheta, Quat(q_i), jacobians[0]);
   }
   if (jacobians[1] != nullptr) {  // vel_i
     Eigen::Map<Eigen::Matrix<double, 9, 3, Eigen::RowMajor>> J(jacobians[1]);
@@ -136,7 +124,7 @@ bool ImuCostFunction::Evaluate(double const* const* parameters, double* residual
         S_theta_Jr_inv * (E_T * RightJacobian(t.phi_bg) * J_b.block<3, 3>(preint::kTheta, preint::kBg));
   }
   if (jacobians[3] != nullptr) {  // pose_j
-    WritePoseJacobian(J_D, S_theta_Jr_inv, Quat(q_j), jacobians[3]);
+    WriteAmbientPoseJacobian<9>(J_D, S_theta_Jr_inv, Quat(q_j), jacobians[3]);
   }
   if (jacobians[4] != nullptr) {  // vel_j
     Eigen::Map<Eigen::Matrix<double, 9, 3, Eigen::RowMajor>> J(jacobians[4]);

@@ -10,16 +10,14 @@ using Mat76 = Eigen::Matrix<double, 7, 6, Eigen::RowMajor>;
 using Mat67 = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
 using Mat34 = Eigen::Matrix<double, 3, 4>;
 
-// ∂Log(q_ref⁻¹·q)/∂q at q = q_ref, columns (x, y, z, w): 2·[w·I − [v]×, −v]. It maps the tangent
-// direction q·(δθ/2, 0) to δθ and the radial direction q to 0.
-Mat34 LogDerivativeAtIdentity(const Quat& q) {
+}  // namespace
+
+Mat34 QuaternionLift(const Quat& q) {
   Mat34 M;
   M.leftCols<3>() = 2.0 * (q.w() * Mat3::Identity() - Hat<double>(q.vec()));
   M.col(3) = -2.0 * q.vec();
   return M;
 }
-
-}  // namespace
 
 bool PoseManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
   const Eigen::Map<const Vec3> p(x + pose::kP);
@@ -64,7 +62,7 @@ void PoseManifold::MinusJacobianAt(const double* y, const double* x, double* jac
   J.block<3, 3>(pose::kP, pose::kP).setIdentity();
   const Vec3 phi = LogQuat<double>(q_x.conjugate() * q_y);
   // Log(q_x⁻¹·q_y·Exp(δ)) = φ + Jr⁻¹(φ)·δ, and M(q_y) turns an ambient change of q_y into that δ.
-  J.block<3, 4>(pose::kTheta, pose::kQ) = RightJacobianInverse(phi) * LogDerivativeAtIdentity(Quat(q_y));
+  J.block<3, 4>(pose::kTheta, pose::kQ) = RightJacobianInverse(phi) * QuaternionLift(Quat(q_y));
 }
 
 }  // namespace gins

@@ -56,4 +56,20 @@ class PoseManifold final : public ceres::Manifold {
   static void MinusJacobianAt(const double* y, const double* x, double* jacobian);
 };
 
+// ∂Log(q⁻¹·q')/∂q' at q' = q, columns (x, y, z, w): 2·[w·I − [v]×, −v] (PoseManifold::MinusJacobian's rotation
+// part). It maps the tangent direction q·(δθ/2, 0) to δθ and the radial direction q to 0.
+Eigen::Matrix<double, 3, 4> QuaternionLift(const Quat& q);
+
+// Writes an M-row Jacobian of a pose block given in the tangent (columns δp, δθ) as the ambient one Ceres
+// wants, J_tan·M(q): the p columns as they are, the q columns J_θ·QuaternionLift(q). Any J_amb with
+// J_amb·PlusJacobian = J_tan is equivalent to Ceres (factors/imu_factor.h, ImuCostFunction, says why); this
+// one has no component along the radial direction q. out: M×7, row-major.
+template <int M, typename DerivedP, typename DerivedTheta>
+void WriteAmbientPoseJacobian(const Eigen::MatrixBase<DerivedP>& J_dp, const Eigen::MatrixBase<DerivedTheta>& J_dtheta,
+                              const Quat& q, double* out) {
+  Eigen::Map<Eigen::Matrix<double, M, pose::kAmbient, Eigen::RowMajor>> J(out);
+  J.template middleCols<3>(pose::kP) = J_dp;
+  J.template middleCols<4>(pose::kQ) = J_dtheta * QuaternionLift(q);
+}
+
 }  // namespace gins

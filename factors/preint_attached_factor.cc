@@ -73,13 +73,9 @@ bool PreintAttachedCostFunction<Measurement>::Evaluate(double const* const* para
   if (jacobians == nullptr) return true;
   const Eigen::Matrix<double, M, 15> J =
       J_meas * PredictionJacobian(pre, factor_.earth(), factor_.turns(), Quat(q_i), Vec3(bg), Vec3(ba));
-  if (jacobians[0] != nullptr) {  // pose_i: tangent (δp, δθ) lifted by M(q) = 2·[w·I − [v]×, −v]
-    Eigen::Matrix<double, 3, 4> Mq;
-    Mq.leftCols<3>() = 2.0 * (q_i.w() * Mat3::Identity() - Hat<double>(q_i.vec()));
-    Mq.col(3) = -2.0 * q_i.vec();
-    Eigen::Map<Eigen::Matrix<double, M, pose::kAmbient, Eigen::RowMajor>> out(jacobians[0]);
-    out.template middleCols<3>(pose::kP) = J.template middleCols<3>(kColP);
-    out.template middleCols<4>(pose::kQ) = J.template middleCols<3>(kColTheta) * Mq;
+  if (jacobians[0] != nullptr) {  // pose_i: tangent (δp, δθ) lifted to the ambient block
+    WriteAmbientPoseJacobian<M>(J.template middleCols<3>(kColP), J.template middleCols<3>(kColTheta), Quat(q_i),
+                                jacobians[0]);
   }
   if (jacobians[1] != nullptr) {
     Eigen::Map<Eigen::Matrix<double, M, 3, Eigen::RowMajor>> out(jacobians[1]);

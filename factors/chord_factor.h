@@ -5,10 +5,13 @@
 // Residual (2):
 //   r = N_i·R_iᵀ·(a_j − a_i) / (Δt·σ)   (unitless; N_i the two directions across the path, σ in m/s, the mean
 //                                        lateral and vertical speed's 1-σ over the interval)
-// The raw residual is ChordModel::Residual.
+// The raw residual is ChordModel::Residual. Jacobians (ChordCostFunction, analytic; autodiff is the test
+// oracle), with d = R_iᵀ·(a_j − a_i), w = R_iᵀ·(p_j + R_j·l − p_i) = d + l and A = N_i/(Δt·σ):
+//   ∂r/∂δp_i = −A·R_iᵀ   ∂r/∂δθ_i = A·[w]×   ∂r/∂δp_j = A·R_iᵀ   ∂r/∂δθ_j = −A·R_iᵀ·R_j·[l]×
 #pragma once
 
 #include <ceres/cost_function.h>
+#include <ceres/sized_cost_function.h>
 
 #include "core/conventions.h"
 #include "core/odometry_model.h"
@@ -36,13 +39,29 @@ class ChordFactor {
     return true;
   }
 
-  // AutoDiffCostFunction<ChordFactor, 2, 7, 7>.
+  // ChordCostFunction (analytic Jacobians).
   static ceres::CostFunction* Create(double dt, double sigma, const Vec3& lever_b, const Vec3& path_i);
+  // AutoDiffCostFunction<ChordFactor, 2, 7, 7> of the same residual: the test oracle.
+  static ceres::CostFunction* CreateAutoDiff(double dt, double sigma, const Vec3& lever_b, const Vec3& path_i);
+
+  double dt() const { return dt_; }
+  double inv_sigma() const { return inv_sigma_; }
+  const Vec3& lever_b() const { return lever_b_; }
+  const Eigen::Matrix<double, 2, 3>& across_i() const { return across_i_; }
 
  private:
   double dt_, inv_sigma_;
   Vec3 lever_b_;
   Eigen::Matrix<double, 2, 3> across_i_;
+};
+
+class ChordCostFunction final : public ceres::SizedCostFunction<2, pose::kAmbient, pose::kAmbient> {
+ public:
+  explicit ChordCostFunction(const ChordFactor& factor) : factor_(factor) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+ private:
+  ChordFactor factor_;
 };
 
 }  // namespace gins

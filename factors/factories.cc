@@ -84,13 +84,13 @@ ceres::CostFunction* GvelFactor::Create(const Vec3& z_w, const Vec3& sigma_w, co
       new GvelFactor(z_w, sigma_w, omega_b, lever_b));
 }
 
-ceres::CostFunction* OdometerFactor::Create(const Vec3& displacement_i, double sigma, const Vec3& lever_b) {
+ceres::CostFunction* OdometerFactor::CreateAutoDiff(const Vec3& displacement_i, double sigma, const Vec3& lever_b) {
   CHECK_GT(sigma, 0.0) << "OdometerFactor: σ must be > 0";
   return new ceres::AutoDiffCostFunction<OdometerFactor, 1, pose::kAmbient, pose::kAmbient, 1>(
       new OdometerFactor(displacement_i, sigma, lever_b));
 }
 
-ceres::CostFunction* ChordFactor::Create(double dt, double sigma, const Vec3& lever_b, const Vec3& path_i) {
+ceres::CostFunction* ChordFactor::CreateAutoDiff(double dt, double sigma, const Vec3& lever_b, const Vec3& path_i) {
   CHECK(dt > 0.0 && sigma > 0.0) << "ChordFactor: dt and σ must be > 0";
   return new ceres::AutoDiffCostFunction<ChordFactor, 2, pose::kAmbient, pose::kAmbient>(
       new ChordFactor(dt, sigma, lever_b, path_i));

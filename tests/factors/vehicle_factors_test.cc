@@ -106,6 +106,54 @@ TEST(VehicleFactorsTest, ChordBasis) {
   }
 }
 
+// The analytic Jacobians of the chord and odometer factors against autodiff of the same residual, in the
+// tangent (ambient pose Jacobians may differ along the quaternion's radial direction, which Ceres never uses).
+TEST(VehicleFactorsTest, AnalyticJacobiansMatchAutoDiff) {
+  std::mt19937 rng(5);
+  const PoseManifold m;
+  const Vec3 D(9.8, 0.5, 0.1);
+  const std::unique_ptr<ceres::CostFunction> chord(ChordFactor::Create(0.8, 0.1, kLever, D));
+  const std::unique_ptr<ceres::CostFunction> chord_ad(ChordFactor::CreateAutoDiff(0.8, 0.1, kLever, D));
+  const std::unique_ptr<ceres::CostFunction> odo(OdometerFactor::Create(D, 0.02, kLever));
+  const std::unique_ptr<ceres::CostFunction> odo_ad(OdometerFactor::CreateAutoDiff(D, 0.02, kLever));
+  for (int trial = 0; trial < 8; ++trial) {
+    const test::PoseBlock pi = test::RandomPose(rng);
+    Vec6 d;
+    d << test::RandomVec3(rng, 5.0), test::RandomVec3(rng, 0.4);
+    const test::PoseBlock pj = test::PosePlus(pi, d);
+    const double s = 0.97 + 0.01 * trial;
+    Eigen::Matrix<double, 7, 6, Eigen::RowMajor> lift_i, lift_j;
+    ASSERT_TRUE(m.PlusJacobian(pi.data(), lift_i.data()));
+    ASSERT_TRUE(m.PlusJacobian(pj.data(), lift_j.data()));
+    const std::string what = "trial " + std::to_string(trial);
+    {
+      const double* params[] = {pi.data(), pj.data()};
+      Vec2 r, r_ad;
+      Eigen::Matrix<double, 2, 7, Eigen::RowMajor> Ji, Jj, Ji_ad, Jj_ad;
+      double* J[] = {Ji.data(), Jj.data()};
+      double* J_ad[] = {Ji_ad.data(), Jj_ad.data()};
+      ASSERT_TRUE(chord->Evaluate(params, r.data(), J));
+      ASSERT_TRUE(chord_ad->Evaluate(params, r_ad.data(), J_ad));
+      EXPECT_LT((r - r_ad).norm(), 1e-9 * (1.0 + r_ad.norm())) << what;
+      EXPECT_LT((Ji * lift_i - Ji_ad * lift_i).norm(), 1e-9 * (Ji_ad * lift_i).norm()) << "chord i " << what;
+      EXPECT_LT((Jj * lift_j - Jj_ad * lift_j).norm(), 1e-9 * (Jj_ad * lift_j).norm()) << "chord j " << what;
+    }
+    {
+      const double* params[] = {pi.data(), pj.data(), &s};
+      double r = 0.0, r_ad = 0.0, Js = 0.0, Js_ad = 0.0;
+      Eigen::Matrix<double, 1, 7> Ji, Jj, Ji_ad, Jj_ad;
+      double* J[] = {Ji.data(), Jj.data(), &Js};
+      double* J_ad[] = {Ji_ad.data(), Jj_ad.data(), &Js_ad};
+      ASSERT_TRUE(odo->Evaluate(params, &r, J));
+      ASSERT_TRUE(odo_ad->Evaluate(params, &r_ad, J_ad));
+      EXPECT_NEAR(r, r_ad, 1e-9 * (1.0 + std::abs(r_ad))) << what;
+      EXPECT_NEAR(Js, Js_ad, 1e-9 * (1.0 + std::abs(Js_ad))) << what;
+      EXPECT_LT((Ji * lift_i - Ji_ad * lift_i).norm(), 1e-9 * (Ji_ad * lift_i).norm()) << "odometer i " << what;
+      EXPECT_LT((Jj * lift_j - Jj_ad * lift_j).norm(), 1e-9 * (Jj_ad * lift_j).norm()) << "odometer j " << what;
+    }
+  }
+}
+
 TEST(VehicleFactorsTest, JacobiansMatchNumeric) {
   std::mt19937 rng(23);
   const PoseManifold m;

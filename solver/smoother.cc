@@ -39,7 +39,8 @@ Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, Stat
                [this](double t) { return PredictAt(t); },
                [this](double t) { return AnchorAt(t); },
                [this]() -> const MatX* { return newest_two_cov_.size() > 0 ? &newest_two_cov_ : nullptr; },
-               [this](double t) { return PartialAt(t); }},
+               [this](double t) { return PartialAt(t); },
+               [this](double t) { return PredictStateAt(t); }},
       watchdog_(options.watchdog) {
   window_.SetLog(factor_log_.get());
   attachers_.push_back(std::make_unique<VehicleAttacher>(options_));
@@ -181,6 +182,12 @@ Prediction Smoother::PredictAt(double t) {
     p.cov = cov;
   }
   return p;
+}
+
+NavState Smoother::PredictStateAt(double t) {
+  IntegrateTo(t);
+  const Keyframe& newest = window_.back();
+  return t - newest.t > kSameEpoch && preint_->dt() > 0.0 ? pred_ : newest.State();
 }
 
 Anchor Smoother::AnchorAt(double t) {

@@ -68,6 +68,7 @@ class Smoother : public Estimator {
   Keyframe& CreateKeyframe(double t);
   // The attachers' services (AttachContext): the prediction at t, and the keyframe policy's anchor.
   Prediction PredictAt(double t);
+  NavState PredictStateAt(double t);
   Anchor AnchorAt(double t);
   Anchor PartialAt(double t);
   // Solves the window if measurements joined it since the last solve.

@@ -76,6 +76,9 @@ struct AttachContext {
   // The newest keyframe and the IMU preintegrated from it to t, never a new keyframe: where a measurement
   // the window rejects is kept for the whole-log smoother (only with a factor log).
   std::function<Anchor(double t)> partial;
+  // The state `predict` gives, without its covariance (a fraction of the cost): for what needs only the
+  // attitude or the biases at t.
+  std::function<NavState(double t)> predict_state;
   // The Earth terms of an IMU interval around p (gravity there, Earth rate).
   ImuEarthTerms EarthTermsAt(const Vec3& p_w) const;
   // The body's rate against w from the last IMU sample, with the biases of x.

@@ -81,9 +81,9 @@ void VehicleAttacher::OnWheel(const WheelMeasurement& m, const AttachContext& ct
   const Keyframe& newest = ctx.keyframes.back();
   const NavState x = newest.State();
   const double mid = 0.5 * (from + m.t);
-  const Prediction now = ctx.predict(m.t);
-  const Quat dR_now = x.q_wb.conjugate() * now.x.q_wb;
-  const Quat dR_mid = dR_now * ExpQuat<double>(Vec3(-ctx.BodyRate(now.x) * (m.t - mid)));
+  const NavState now = ctx.predict_state(m.t);
+  const Quat dR_now = x.q_wb.conjugate() * now.q_wb;
+  const Quat dR_mid = dR_now * ExpQuat<double>(Vec3(-ctx.BodyRate(now) * (m.t - mid)));
   Add(&*open_, m, (m.t - from) / m.interval, dR_mid);
 }
 

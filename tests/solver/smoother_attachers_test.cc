@@ -28,7 +28,8 @@ class AttacherTest : public ::testing::Test {
                  [this](double t) { return Predict(t); },
                  [this](double t) { return Anchor(t); },
                  [this]() -> const MatX* { return two_.size() > 0 ? &two_ : nullptr; },
-                 [this](double t) { return Anchor(t); }} {
+                 [this](double t) { return Anchor(t); },
+                 [this](double t) { return Predict(t).x; }} {
     options_.gnss.lever_b = Vec3::Zero();
     options_.wheel.lever_b = Vec3::Zero();
     store_.Reset(&problem_);

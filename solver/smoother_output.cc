@@ -87,17 +87,41 @@ bool InverseColumns(const SpMat& H, const std::vector<int>& columns, MatX* C) {
 
 // H = JᵀJ of a CRS Jacobian, accumulated row by row (Σ rᵢᵀrᵢ) into a dense matrix and kept sparse (exact
 // zeros dropped). The window's rows touch one or two keyframes: 20 % fewer instructions than Eigen's
-// general sparse-sparse product, which spends them on structure bookkeeping.
+// general sparse-sparse product, which spends them on structure bookkeeping. Each column's touched rows form
+// one range (its band), so only the bands are read out and cleared: the dense scratch is zeroed once per
+// thread and size, not per call.
 SpMat Information(const ceres::CRSMatrix& J) {
-  MatX H = MatX::Zero(J.num_cols, J.num_cols);
+  const int n = J.num_cols;
+  thread_local MatX scratch;
+  if (scratch.rows() != n) scratch = MatX::Zero(n, n);
+  MatX& H = scratch;
+  std::vector<int> lo(n, n), hi(n, -1);
   for (int r = 0; r < J.num_rows; ++r) {
-    for (int a = J.rows[r]; a < J.rows[r + 1]; ++a) {
+    const int begin = J.rows[r], end = J.rows[r + 1];
+    if (begin == end) continue;
+    const auto [c_min, c_max] = std::minmax_element(J.cols.begin() + begin, J.cols.begin() + end);
+    for (int a = begin; a < end; ++a) {
+      const int c = J.cols[a];
+      lo[c] = std::min(lo[c], *c_min);
+      hi[c] = std::max(hi[c], *c_max);
       const double va = J.values[a];
       if (va == 0.0) continue;
-      for (int b = J.rows[r]; b < J.rows[r + 1]; ++b) H(J.cols[a], J.cols[b]) += va * J.values[b];
+      for (int b = begin; b < end; ++b) H(c, J.cols[b]) += va * J.values[b];
     }
   }
-  return H.sparseView(1.0, 0.0);  // reference 1, epsilon 0: only exact zeros are dropped
+  int nnz = 0;
+  for (int c = 0; c < n; ++c) nnz += std::max(0, hi[c] - lo[c] + 1);
+  SpMat out(n, n);
+  out.reserve(nnz);
+  for (int c = 0; c < n; ++c) {
+    out.startVec(c);
+    for (int r = lo[c]; r <= hi[c]; ++r) {
+      if (H(r, c) != 0.0) out.insertBack(r, c) = H(r, c);
+      H(r, c) = 0.0;
+    }
+  }
+  out.finalize();
+  return out;
 }
 
 }  // namespace

@@ -26,7 +26,7 @@ struct SmootherOptions {
   double function_tolerance = 1e-6;  // smoother.function_tolerance: stop when |Δcost|/cost falls below
   int num_threads = 1;              // smoother.num_threads
   double gnss_loss_scale = 3.0;     // smoother.gnss_loss_scale: Cauchy loss scale on whitened residuals
-  double bias_reintegrate_threshold = 1e-3;  // smoother.bias_reintegrate_threshold (norm of δb)
+  double bias_reintegrate_threshold = 1e-3;  // smoother.bias_reintegrate_threshold (norm of δbg, rad/s)
 };
 
 // batch.*: the whole-log smoother (--mode batch; solver/batch_smoother.h).

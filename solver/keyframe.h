@@ -156,9 +156,10 @@ struct BlockRef {
 
 class FactorLog;
 
-// The IMU from prev to a keyframe integrated again at prev's bias estimate, when that moved further than
-// threshold (norm of δb, rad/s and m/s² together) from where `pre` was integrated; null otherwise (the
-// factor's first-order bias Jacobians cover the rest). A new object: live factors never see theirs change.
+// The IMU from prev to a keyframe integrated again at prev's bias estimate, when its gyro bias moved further
+// than threshold (rad/s) from where `pre` was integrated; null otherwise (the factor's first-order bias
+// Jacobians cover the rest, exactly for the accelerometer bias). A new object: live factors never see theirs
+// change.
 std::shared_ptr<Preintegration> ReintegratedIfMoved(const Keyframe& prev, const Preintegration& pre,
                                                     double threshold);
 

@@ -17,7 +17,6 @@ constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8
                              1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 constexpr int kMaxPow10 = 22;
 constexpr double kMaxInteger = 1.0e18;  // the integer part fits a uint64_t
-constexpr double kLog10Of2 = 0.30102999566398120;
 
 // x ≥ 0 (below 2^62) rounded to the nearest integer, ties to even as to_chars does; inline, unlike rint.
 uint64_t RoundHalfEven(double x) {
@@ -126,7 +125,9 @@ char* FormatScientific(char* first, char* last, double v, int precision) {
   std::memcpy(&bits, &a, sizeof(bits));
   const int biased = static_cast<int>(bits >> 52) & 0x7ff;  // a = 1.f·2^(biased − 1023); 0: subnormal
   if (biased == 0) return Fallback(first, last, v, std::chars_format::scientific, precision);
-  int e = static_cast<int>(std::floor((biased - 1023) * kLog10Of2));
+  // floor(k·log10 2) in integers: 78913/2^18 ≈ log10 2, exact for |k| ≤ 2620 (a double's k is within ±1023);
+  // the arithmetic shift floors negative k. std::floor is a library call on baseline x86-64.
+  int e = ((biased - 1023) * 78913) >> 18;
   // Mantissa digits: a / 10^e scaled by 10^precision, computed as one product or quotient of exact powers.
   auto digits = [&](int exp10) -> long long {
     const int shift = precision - exp10;  // a · 10^shift

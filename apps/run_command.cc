@@ -41,8 +41,11 @@ class OutputStream {
 
   void Add(const StateEstimate& e) {
     if (!filter_.Accept(e)) return;
-    tum_.Add(e.x);
-    if (states_) states_->Add(e.x, e.sigma_p, e.sigma_v, e.sigma_att, e.odom_scale);
+    if (states_) {
+      tum_.AddWithStates(states_.get(), e.x, e.sigma_p, e.sigma_v, e.sigma_att, e.odom_scale);
+    } else {
+      tum_.Add(e.x);
+    }
   }
 
   std::vector<std::string> Commit(const std::string& dir) {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -32,6 +33,13 @@ class Line {
   }
   Line& Char(char c) {
     if (pos_ < end_) *pos_++ = c;
+    return *this;
+  }
+  // A field formatted before (PoseFields).
+  Line& Text(const char* first, const char* last) {
+    const size_t n = std::min(static_cast<size_t>(last - first), static_cast<size_t>(end_ - pos_));
+    std::memcpy(pos_, first, n);
+    pos_ += n;
     return *this;
   }
   void WriteTo(FILE* f) { std::fwrite(buf_, 1, static_cast<size_t>(pos_ - buf_), f); }
@@ -86,14 +94,62 @@ const char kStatesCsvColumns[] =
     "t,px,py,pz,vx,vy,vz,qw,qx,qy,qz,bgx,bgy,bgz,bax,bay,baz,"
     "sigma_px,sigma_py,sigma_pz,sigma_vx,sigma_vy,sigma_vz,sigma_att_e,sigma_att_n,sigma_att_u,odom_scale\n";
 
+namespace {
+
+// The fields both formats share, formatted once: t, p (x, y, z) and q (x, y, z, w), each [begin[k], end[k]).
+class PoseFields {
+ public:
+  static constexpr int kT = 0, kP = 1, kQ = 4, kFields = 8;
+  explicit PoseFields(const NavState& x) {
+    const double v[kFields] = {x.t, x.p_wb.x(), x.p_wb.y(), x.p_wb.z(), x.q_wb.x(), x.q_wb.y(), x.q_wb.z(), x.q_wb.w()};
+    char* p = buf_;
+    for (int k = 0; k < kFields; ++k) {
+      begin_[k] = p;
+      p = FormatFixed(p, buf_ + sizeof(buf_), v[k], k == kT ? 6 : k < kQ ? 5 : 9);
+      end_[k] = p;
+    }
+  }
+  const char* begin(int k) const { return begin_[k]; }
+  const char* end(int k) const { return end_[k]; }
+
+ private:
+  char buf_[kFields * (kMaxField + 1)];
+  const char* begin_[kFields];
+  const char* end_[kFields];
+};
+
+void WriteTum(FILE* f, const PoseFields& pose) {
+  Line l;
+  l.Text(pose.begin(PoseFields::kT), pose.end(PoseFields::kT));
+  for (int k = PoseFields::kP; k < PoseFields::kFields; ++k) l.Char(' ').Text(pose.begin(k), pose.end(k));
+  l.Char('\n').WriteTo(f);
+}
+
+bool StatesFinite(const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa, double odom_scale) {
+  return x.AllFinite() && sp.allFinite() && sv.allFinite() && sa.allFinite() && std::isfinite(odom_scale);
+}
+
+void WriteStatesCsv(FILE* f, const PoseFields& pose, const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa,
+                    double odom_scale) {
+  Line l;
+  l.Text(pose.begin(PoseFields::kT), pose.end(PoseFields::kT));
+  for (int i = 0; i < 3; ++i) l.Char(',').Text(pose.begin(PoseFields::kP + i), pose.end(PoseFields::kP + i));
+  for (int i = 0; i < 3; ++i) l.Char(',').Fixed(x.v_w[i], 5);
+  // q as w, x, y, z here.
+  l.Char(',').Text(pose.begin(PoseFields::kQ + 3), pose.end(PoseFields::kQ + 3));
+  for (int i = 0; i < 3; ++i) l.Char(',').Text(pose.begin(PoseFields::kQ + i), pose.end(PoseFields::kQ + i));
+  for (const Vec3* v : {&x.bg, &x.ba, &sp, &sv, &sa}) {
+    for (int i = 0; i < 3; ++i) l.Char(',').Sci((*v)[i], 4);
+  }
+  l.Char(',').Fixed(odom_scale, 6).Char('\n');
+  l.WriteTo(f);
+}
+
+}  // namespace
+
 bool WriteTumLine(FILE* f, const NavState& x) {
   if (!x.AllFinite()) return false;
-  Line l;
-  l.Fixed(x.t, 6);
-  for (int i = 0; i < 3; ++i) l.Char(' ').Fixed(x.p_wb[i], 5);
-  l.Char(' ').Fixed(x.q_wb.x(), 9).Char(' ').Fixed(x.q_wb.y(), 9).Char(' ').Fixed(x.q_wb.z(), 9);
-  l.Char(' ').Fixed(x.q_wb.w(), 9).Char('\n');
-  l.WriteTo(f);
+  WriteTum(f, PoseFields(x));
   return true;
 }
 
@@ -115,20 +171,18 @@ bool StatesCsvWriter::Add(const NavState& x, const Vec3& sp, const Vec3& sv, con
 
 bool WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa,
                         double odom_scale) {
-  if (!x.AllFinite() || !sp.allFinite() || !sv.allFinite() || !sa.allFinite() || !std::isfinite(odom_scale)) {
-    return false;
-  }
-  Line l;
-  l.Fixed(x.t, 6);
-  for (int i = 0; i < 3; ++i) l.Char(',').Fixed(x.p_wb[i], 5);
-  for (int i = 0; i < 3; ++i) l.Char(',').Fixed(x.v_w[i], 5);
-  l.Char(',').Fixed(x.q_wb.w(), 9).Char(',').Fixed(x.q_wb.x(), 9).Char(',').Fixed(x.q_wb.y(), 9);
-  l.Char(',').Fixed(x.q_wb.z(), 9);
-  for (const Vec3* v : {&x.bg, &x.ba, &sp, &sv, &sa}) {
-    for (int i = 0; i < 3; ++i) l.Char(',').Sci((*v)[i], 4);
-  }
-  l.Char(',').Fixed(odom_scale, 6).Char('\n');
-  l.WriteTo(f);
+  if (!StatesFinite(x, sp, sv, sa, odom_scale)) return false;
+  WriteStatesCsv(f, PoseFields(x), x, sp, sv, sa, odom_scale);
+  return true;
+}
+
+bool TumWriter::AddWithStates(StatesCsvWriter* states, const NavState& x, const Vec3& sp, const Vec3& sv,
+                              const Vec3& sa, double odom_scale) {
+  if (!x.AllFinite()) return false;
+  const PoseFields pose(x);
+  WriteTum(file_.stream(), pose);
+  ++count_;
+  if (StatesFinite(x, sp, sv, sa, odom_scale)) WriteStatesCsv(states->stream(), pose, x, sp, sv, sa, odom_scale);
   return true;
 }
 

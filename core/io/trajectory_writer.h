@@ -42,11 +42,17 @@ bool WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sigma_p, const V
 // The states CSV's column header line (after the TrajectoryHeader comment).
 extern const char kStatesCsvColumns[];
 
+class StatesCsvWriter;
+
 // TUM trajectory: "t x y z qx qy qz qw" (body in w).
 class TumWriter {
  public:
   TumWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin);
   bool Add(const NavState& x);
+  // Add(x) and states->Add(x, ...) in one, formatting the fields the two lines share (t, p, q) once: the
+  // same bytes as the two calls.
+  bool AddWithStates(StatesCsvWriter* states, const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v,
+                     const Vec3& sigma_att, double odom_scale);
   void Commit() { file_.Commit(); }
   uint64_t count() const { return count_; }
 
@@ -61,6 +67,7 @@ class StatesCsvWriter {
   StatesCsvWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin);
   bool Add(const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att, double odom_scale);
   void Commit() { file_.Commit(); }
+  FILE* stream() { return file_.stream(); }
 
  private:
   AtomicFile file_;

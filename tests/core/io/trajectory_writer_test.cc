@@ -243,5 +243,37 @@ TEST(StatesCsvWriter, RefusesNonFiniteStatesAndWritesHugeOnesWhole) {
   }
 }
 
+// TumWriter::AddWithStates writes the bytes Add and StatesCsvWriter::Add write, huge values included; a state
+// with a non-finite σ still gets its TUM line (the TUM has no σ) but no CSV line, as with the two calls.
+TEST(TumWriter, AddWithStatesWritesWhatTheTwoWritersWrite) {
+  const std::string dir = test::MakeTempDir("tum_with_states");
+  NavState huge = SampleState();
+  huge.t += 1.0;
+  huge.p_wb = Vec3(-1e300, 2.5e17, -0.0);
+  huge.q_wb = Quat(0.5, -0.5, 0.5, -0.5);
+  const Vec3 s(0.1, 2e-7, 3e4);
+  const Vec3 nan_sigma(0.1, std::nan(""), 0.1);
+  for (const char* variant : {"pair", "one"}) {
+    const std::string base = dir + "/" + variant;
+    TumWriter t(base + ".tum", "eskf", kOrigin);
+    StatesCsvWriter w(base + "_states.csv", "eskf", kOrigin);
+    const std::pair<NavState, Vec3> rows[] = {{SampleState(), s}, {huge, s}, {SampleState(), nan_sigma}};
+    for (const auto& [x, sigma] : rows) {
+      if (std::string(variant) == "pair") {
+        t.Add(x);
+        w.Add(x, sigma, s, s, 0.99);
+      } else {
+        EXPECT_TRUE(t.AddWithStates(&w, x, sigma, s, s, 0.99));
+      }
+    }
+    EXPECT_EQ(t.count(), 3u);
+    t.Commit();
+    w.Commit();
+  }
+  EXPECT_EQ(test::ReadFile(dir + "/one.tum"), test::ReadFile(dir + "/pair.tum"));
+  EXPECT_EQ(test::ReadFile(dir + "/one_states.csv"), test::ReadFile(dir + "/pair_states.csv"));
+  EXPECT_EQ(Lines(test::ReadFile(dir + "/one_states.csv")).size(), 4u);  // header, columns, two rows
+}
+
 }  // namespace
 }  // namespace gins

@@ -174,7 +174,7 @@ Prediction Smoother::PredictAt(double t) {
     const Keyframe& solved = window_[window_.size() - 2];
     cov = PredictBlockCovariance(types, newest_cov_, solved.State(), *newest.preint, options_);
   }
-  if (t - newest.t > kSameEpoch && preint_->dt() > 0.0) {
+  if (BeyondNewest(t)) {
     p.x = pred_;
     p.cov = PredictBlockCovariance(types, cov, newest.State(), *preint_, options_);
   } else {
@@ -186,8 +186,11 @@ Prediction Smoother::PredictAt(double t) {
 
 NavState Smoother::PredictStateAt(double t) {
   IntegrateTo(t);
-  const Keyframe& newest = window_.back();
-  return t - newest.t > kSameEpoch && preint_->dt() > 0.0 ? pred_ : newest.State();
+  return BeyondNewest(t) ? pred_ : window_.back().State();
+}
+
+bool Smoother::BeyondNewest(double t) const {
+  return t - window_.back().t > kSameEpoch && preint_->dt() > 0.0;
 }
 
 Anchor Smoother::AnchorAt(double t) {

@@ -69,6 +69,8 @@ class Smoother : public Estimator {
   // The attachers' services (AttachContext): the prediction at t, and the keyframe policy's anchor.
   Prediction PredictAt(double t);
   NavState PredictStateAt(double t);
+  // t is past the newest keyframe's epoch and the IMU integrated from it (the prediction is pred_).
+  bool BeyondNewest(double t) const;
   Anchor AnchorAt(double t);
   Anchor PartialAt(double t);
   // Solves the window if measurements joined it since the last solve.

@@ -1,4 +1,4 @@
-// Helpers shared by the factor tests: random poses and a GradientChecker wrapper.
+// Helpers shared by the factor tests: random poses, a GradientChecker wrapper and an analytic-vs-oracle check.
 #pragma once
 
 #include <ceres/gradient_checker.h>
@@ -40,6 +40,50 @@ inline PoseBlock PosePlus(const PoseBlock& x, const Vec6& delta) {
   PoseBlock y;
   PoseManifold().Plus(x.data(), delta.data(), y.data());
   return y;
+}
+
+// A pose near x: x ⊞ (δp, δθ), each component drawn with σ sigma_p (m) and sigma_theta (rad), δp first.
+inline PoseBlock RandomPoseNear(std::mt19937& rng, const PoseBlock& x, double sigma_p, double sigma_theta) {
+  Vec6 d;
+  d.head<3>() = RandomVec3(rng, sigma_p);
+  d.tail<3>() = RandomVec3(rng, sigma_theta);
+  return PosePlus(x, d);
+}
+
+// Two cost functions of the same residual (an analytic one and its autodiff oracle) agree at `parameters`:
+// residuals to 1e-9·(1 + |r|); each block's Jacobian in the tangent (a manifold block's ambient Jacobian
+// times its PlusJacobian: ambient Jacobians may differ along directions Ceres never uses) to 1e-9 of its norm,
+// a Euclidean block's to 1e-9·(1 + its norm).
+inline void ExpectSameResidualAndJacobians(const ceres::CostFunction& a, const ceres::CostFunction& b,
+                                           const std::vector<const ceres::Manifold*>& manifolds,
+                                           const std::vector<const double*>& parameters, const std::string& what) {
+  using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const int m = a.num_residuals();
+  const std::vector<int32_t>& sizes = a.parameter_block_sizes();
+  Eigen::VectorXd r_a(m), r_b(m);
+  std::vector<RowMat> J_a, J_b;
+  std::vector<double*> ptr_a, ptr_b;
+  for (int32_t size : sizes) {
+    J_a.emplace_back(m, size);
+    J_b.emplace_back(m, size);
+  }
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    ptr_a.push_back(J_a[k].data());
+    ptr_b.push_back(J_b[k].data());
+  }
+  ASSERT_TRUE(a.Evaluate(parameters.data(), r_a.data(), ptr_a.data())) << what;
+  ASSERT_TRUE(b.Evaluate(parameters.data(), r_b.data(), ptr_b.data())) << what;
+  EXPECT_LT((r_a - r_b).norm(), 1e-9 * (1.0 + r_b.norm())) << what;
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    if (manifolds[k] == nullptr) {
+      EXPECT_LT((J_a[k] - J_b[k]).norm(), 1e-9 * (1.0 + J_b[k].norm())) << what << ", block " << k;
+      continue;
+    }
+    RowMat lift(sizes[k], manifolds[k]->TangentSize());
+    ASSERT_TRUE(manifolds[k]->PlusJacobian(parameters[k], lift.data())) << what;
+    const RowMat t_a = J_a[k] * lift, t_b = J_b[k] * lift;
+    EXPECT_LT((t_a - t_b).norm(), 1e-9 * t_b.norm()) << what << ", block " << k;
+  }
 }
 
 // Probes cost's Jacobians in tangent space (manifold per block, nullptr = Euclidean) with

@@ -65,9 +65,7 @@ TEST(GnssPreintFactorTest, JacobiansMatchNumeric) {
   const PoseManifold m;
   std::mt19937 rng(9);
   for (int trial = 0; trial < 6; ++trial) {
-    Vec6 d;
-    d << test::RandomVec3(rng, 1.0), test::RandomVec3(rng, 0.3);
-    const test::PoseBlock pose = test::PosePlus(s.pose_i, d);
+    const test::PoseBlock pose = test::RandomPoseNear(rng, s.pose_i, 1.0, 0.3);
     const Vec3 v = s.vel_i + test::RandomVec3(rng, 1.0);
     Vec6 b = s.bias;
     b.head<3>() += test::RandomVec3(rng, 0.02);

@@ -55,9 +55,7 @@ void ExpectAnalyticMatches(const Measurement& measurement, const std::string& wh
     const PoseManifold manifold;
     std::mt19937 rng(17);
     for (int trial = 0; trial < 8; ++trial) {
-      Vec6 d;
-      d << test::RandomVec3(rng, 1.0), test::RandomVec3(rng, 0.3);
-      const test::PoseBlock pose = test::PosePlus(s.pose_i, d);
+      const test::PoseBlock pose = test::RandomPoseNear(rng, s.pose_i, 1.0, 0.3);
       const Vec3 v = s.vel_i + test::RandomVec3(rng, 1.0);
       Vec6 b = s.bias;
       b.head<3>() += test::RandomVec3(rng, 0.02);

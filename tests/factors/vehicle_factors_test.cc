@@ -118,39 +118,12 @@ TEST(VehicleFactorsTest, AnalyticJacobiansMatchAutoDiff) {
   const std::unique_ptr<ceres::CostFunction> odo_ad(OdometerFactor::CreateAutoDiff(D, 0.02, kLever));
   for (int trial = 0; trial < 8; ++trial) {
     const test::PoseBlock pi = test::RandomPose(rng);
-    Vec6 d;
-    d << test::RandomVec3(rng, 5.0), test::RandomVec3(rng, 0.4);
-    const test::PoseBlock pj = test::PosePlus(pi, d);
+    const test::PoseBlock pj = test::RandomPoseNear(rng, pi, 5.0, 0.4);
     const double s = 0.97 + 0.01 * trial;
-    Eigen::Matrix<double, 7, 6, Eigen::RowMajor> lift_i, lift_j;
-    ASSERT_TRUE(m.PlusJacobian(pi.data(), lift_i.data()));
-    ASSERT_TRUE(m.PlusJacobian(pj.data(), lift_j.data()));
     const std::string what = "trial " + std::to_string(trial);
-    {
-      const double* params[] = {pi.data(), pj.data()};
-      Vec2 r, r_ad;
-      Eigen::Matrix<double, 2, 7, Eigen::RowMajor> Ji, Jj, Ji_ad, Jj_ad;
-      double* J[] = {Ji.data(), Jj.data()};
-      double* J_ad[] = {Ji_ad.data(), Jj_ad.data()};
-      ASSERT_TRUE(chord->Evaluate(params, r.data(), J));
-      ASSERT_TRUE(chord_ad->Evaluate(params, r_ad.data(), J_ad));
-      EXPECT_LT((r - r_ad).norm(), 1e-9 * (1.0 + r_ad.norm())) << what;
-      EXPECT_LT((Ji * lift_i - Ji_ad * lift_i).norm(), 1e-9 * (Ji_ad * lift_i).norm()) << "chord i " << what;
-      EXPECT_LT((Jj * lift_j - Jj_ad * lift_j).norm(), 1e-9 * (Jj_ad * lift_j).norm()) << "chord j " << what;
-    }
-    {
-      const double* params[] = {pi.data(), pj.data(), &s};
-      double r = 0.0, r_ad = 0.0, Js = 0.0, Js_ad = 0.0;
-      Eigen::Matrix<double, 1, 7> Ji, Jj, Ji_ad, Jj_ad;
-      double* J[] = {Ji.data(), Jj.data(), &Js};
-      double* J_ad[] = {Ji_ad.data(), Jj_ad.data(), &Js_ad};
-      ASSERT_TRUE(odo->Evaluate(params, &r, J));
-      ASSERT_TRUE(odo_ad->Evaluate(params, &r_ad, J_ad));
-      EXPECT_NEAR(r, r_ad, 1e-9 * (1.0 + std::abs(r_ad))) << what;
-      EXPECT_NEAR(Js, Js_ad, 1e-9 * (1.0 + std::abs(Js_ad))) << what;
-      EXPECT_LT((Ji * lift_i - Ji_ad * lift_i).norm(), 1e-9 * (Ji_ad * lift_i).norm()) << "odometer i " << what;
-      EXPECT_LT((Jj * lift_j - Jj_ad * lift_j).norm(), 1e-9 * (Jj_ad * lift_j).norm()) << "odometer j " << what;
-    }
+    test::ExpectSameResidualAndJacobians(*chord, *chord_ad, {&m, &m}, {pi.data(), pj.data()}, "chord " + what);
+    test::ExpectSameResidualAndJacobians(*odo, *odo_ad, {&m, &m, nullptr}, {pi.data(), pj.data(), &s},
+                                         "odometer " + what);
   }
 }
 
@@ -165,9 +138,7 @@ TEST(VehicleFactorsTest, JacobiansMatchNumeric) {
       GvelFactor::Create(Vec3(3, 4, 0.1), Vec3(0.05, 0.05, 0.1), Vec3(0.01, -0.02, 0.3), Vec3(0.5, -0.3, 1.2)));
   for (int trial = 0; trial < 8; ++trial) {
     const test::PoseBlock pi = test::RandomPose(rng);
-    Vec6 d;
-    d << test::RandomVec3(rng, 5.0), test::RandomVec3(rng, 0.4);
-    const test::PoseBlock pj = test::PosePlus(pi, d);
+    const test::PoseBlock pj = test::RandomPoseNear(rng, pi, 5.0, 0.4);
     const double s = 1.0 + 0.02 * trial;
     const Vec3 v = test::RandomVec3(rng, 8.0);
     const std::string what = "trial " + std::to_string(trial);

@@ -106,6 +106,7 @@ inline constexpr auto kEskfKeys = [](auto& v, EskfOptions& o) {
   v.Boolean("estimate_gravity", o.estimate_gravity);
   v.Number("gravity_sigma_m_s2", o.gravity_sigma, kNoUnit, Positive());
   v.Integer("iterations", o.iterations, 1, 50);
+  v.Number("covariance_interval_s", o.covariance_interval, kNoUnit, Within(0.0, 0.1));
 };
 
 inline constexpr auto kSmootherKeys = [](auto& v, SmootherOptions& o) {

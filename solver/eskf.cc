@@ -38,7 +38,9 @@ Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state, StateCallbac
 Eskf::~Eskf() = default;
 
 void Eskf::Finish() {
-  if (!initialized_ || !rts_) return;
+  if (!initialized_) return;
+  FlushCovariance();
+  if (!rts_) return;
   rts_->AfterUpdates(Nominal(), P_);
   rts_->Smooth(earth_, on_rts_);
 }
@@ -49,6 +51,7 @@ void Eskf::Initialize(const InitResult& init) {
   dg_w_.setZero();
   scale_ = 1.0;
   P_.setZero();
+  pending_ = PendingCovariance();
   P_.topLeftCorner<nav::kDim, nav::kDim>() = init.P0;
   if (options_.eskf.estimate_gravity) {
     BlockOf<Block::kG>(P_).diagonal().setConstant(options_.eskf.gravity_sigma * options_.eskf.gravity_sigma);
@@ -87,9 +90,16 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   const Vec3& rate_w = earth_.rate_w();
   const Vec3 omega = gap ? Vec3(x_.q_wb.conjugate() * rate_w) : Vec3(held->gyro - x_.bg);
   const Vec3 acc = gap ? Vec3(x_.q_wb.conjugate() * (2.0 * rate_w.cross(x_.v_w) - g_w)) : Vec3(held->acc - x_.ba);
+  // The covariance steps per sample, or over intervals of several (FlushCovariance), never across a gap.
+  const bool per_sample = gap || options_.eskf.covariance_interval <= 0.0;
+  if (gap) FlushCovariance();
   Kinematics k{x_.q_wb, x_.v_w, x_.p_wb};
+  if (!per_sample && pending_.steps == 0) {
+    pending_.start = k;
+    pending_.g_w = g_w;
+  }
   ImuStepJacobians J;
-  k = ImuStep(k, omega, acc, g_w, dt, &J, rate_w);
+  k = ImuStep(k, omega, acc, g_w, dt, per_sample ? &J : nullptr, rate_w);
   if (gap) {
     // The coast's transition (CoastCovariance): its errors depend on neither the attitude nor the biases.
     J.A.block<3, 3>(0, 6).setZero();
@@ -98,7 +108,7 @@ void Eskf::Propagate(double t, const ImuSample* held) {
     J.B.setZero();
     J.G.setZero();
   }
-  if (rts_) rts_->Step(J, omega + x_.bg, acc + x_.ba, x_.t, dt);
+  if (rts_) rts_->RecordStep(omega + x_.bg, acc + x_.ba, x_.t, dt);
   a_w_ = (k.v - x_.v_w) / dt;
   x_.q_wb = k.q;
   x_.v_w = k.v;
@@ -106,10 +116,35 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   x_.t = t;
   ++imu_steps_;
   if (gap) {
+    if (rts_) rts_->Compound(J);
     CoastCovariance(dt);
-  } else {
+  } else if (per_sample) {
+    if (rts_) rts_->Compound(J);
     PropagateCovariance(J, dt);
+  } else {
+    pending_.omega = omega;
+    pending_.acc = acc;
+    pending_.omega_dt += omega * dt;
+    pending_.acc_dt += acc * dt;
+    pending_.dt += dt;
+    ++pending_.steps;
+    if (pending_.dt >= options_.eskf.covariance_interval - 1e-9) FlushCovariance();
   }
+}
+
+void Eskf::FlushCovariance() {
+  if (pending_.steps == 0) return;
+  // One kernel step over the interval from its start, at the mean rate and specific force: the first-order
+  // transition of the samples' steps (their product differs in second-order terms of the interval). A
+  // single step is the sample's own, bit for bit.
+  const double dt = pending_.dt;
+  const Vec3 omega = pending_.steps == 1 ? pending_.omega : Vec3(pending_.omega_dt / dt);
+  const Vec3 acc = pending_.steps == 1 ? pending_.acc : Vec3(pending_.acc_dt / dt);
+  ImuStepJacobians J;
+  ImuStep(pending_.start, omega, acc, pending_.g_w, dt, &J, earth_.rate_w());
+  if (rts_) rts_->Compound(J);
+  PropagateCovariance(J, dt);
+  pending_ = PendingCovariance();
 }
 
 void Eskf::CoastCovariance(double dt) {
@@ -195,6 +230,7 @@ bool Eskf::Update(const Model<M>& model, const Eigen::Matrix<double, M, M>& R, d
                   Eigen::Matrix<double, M, M>* S_out) {
   using MatM = Eigen::Matrix<double, M, M>;
   using MatPM = Eigen::Matrix<double, eskf::kDim, M>;
+  FlushCovariance();
   Linearized<M> lin = model();
   if (S_out != nullptr || innovation_out != nullptr) {
     if (S_out != nullptr) *S_out = lin.H * P_.lazyProduct(lin.H.transpose()) + R;
@@ -301,6 +337,7 @@ bool Eskf::WatchGnss(const GnssMeasurement& m, bool accepted) {
 }
 
 void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
+  FlushCovariance();
   if (rts_) rts_->AfterUpdates(Nominal(), P_);  // the chain before the re-initialisation ends here
   const bool finite = x_.AllFinite() && P_.allFinite();
   if (!finite) {

@@ -66,7 +66,11 @@ class Eskf : public Estimator {
   nlohmann::json Stats() const override;
 
   const NavState& state() const { return x_; }
-  const MatP& covariance() const { return P_; }
+  // The covariance at the current time (a pending covariance interval is stepped first).
+  const MatP& covariance() {
+    FlushCovariance();
+    return P_;
+  }
   // Gravity in w at the current position: the Earth model's, plus the estimated correction (δg).
   Vec3 gravity() const { return earth_.Gravity(x_.p_wb) + dg_w_; }
   // The body's rate against w (rad/s) from the last IMU sample: gyro less bias less the Earth rate.
@@ -82,6 +86,9 @@ class Eskf : public Estimator {
   void Propagate(double t, const ImuSample* held = nullptr);
   // P through one kernel step (J) of dt; gap: the step coasted over an IMU gap.
   void PropagateCovariance(const ImuStepJacobians& J, double dt);
+  // Steps the covariance over the pending interval (nothing pending: no change). P_ is current only after
+  // this: every update and reset calls it first.
+  void FlushCovariance();
   // The covariance over a step no IMU sample covers (an IMU gap): see kImuGapAccDensity.
   void CoastCovariance(double dt);
   // The random walks of the driving and passive blocks over dt.
@@ -130,6 +137,17 @@ class Eskf : public Estimator {
   Vec3 dg_w_ = Vec3::Zero();  // the estimated correction of the model's gravity
   double scale_ = 1.0;
   MatP P_ = MatP::Identity();
+  // The samples' steps since the covariance's last step (eskf.covariance_interval_s): P_ is as of their
+  // start. Estimate() reports its σ from P_ as it is.
+  struct PendingCovariance {
+    Kinematics start;    // the state at the interval's start
+    Vec3 g_w = Vec3::Zero();  // gravity there
+    Vec3 omega_dt = Vec3::Zero(), acc_dt = Vec3::Zero();  // ∫ω dt, ∫a dt of the bias-corrected samples
+    Vec3 omega = Vec3::Zero(), acc = Vec3::Zero();        // the last step's ω and a
+    double dt = 0.0;
+    int steps = 0;
+  };
+  PendingCovariance pending_;
   std::optional<ImuSample> last_imu_;
   double last_sample_t_ = 0.0;  // the newest sample's time; the initialisation's epoch before the first one
   Vec3 a_w_ = Vec3::Zero();  // acceleration in w over the last IMU step

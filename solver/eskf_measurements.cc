@@ -31,6 +31,7 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
   if (!initialized_ || m.t < x_.t) return;
   Propagate(m.t);
   if (options_.watchdog.enabled) {
+    FlushCovariance();
     const double max_sigma = options_.watchdog.max_position_sigma;
     const bool finite = x_.AllFinite() && P_.allFinite() && dg_w_.allFinite() && std::isfinite(scale_);
     if (!finite || BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {

@@ -139,16 +139,20 @@ void EskfRts::StartChain(const EskfNominal& x, const MatP& P) {
   ++chains_;
 }
 
-void EskfRts::Step(const ImuStepJacobians& J, const Vec3& gyro, const Vec3& acc, double t_before, double dt) {
+void EskfRts::RecordStep(const Vec3& gyro, const Vec3& acc, double t_before, double dt) {
+  if (failed_) return;
+  const std::array<double, 8> step = {t_before, gyro.x(), gyro.y(), gyro.z(), acc.x(), acc.y(), acc.z(), dt};
+  if (std::fwrite(step.data(), sizeof(double), step.size(), steps_file_) != step.size()) failed_ = true;
+  ++steps_;
+}
+
+void EskfRts::Compound(const ImuStepJacobians& J) {
   if (failed_) return;
   // Φ ← F·Φ with F = [[A, C], [0, I]]: Φa ← A·Φa, Φc ← A·Φc + C.
   phi_a_ = MulA<kA>(J, phi_a_);
   Eigen::Matrix<double, kD, kB> E = Eigen::Matrix<double, kD, kB>::Zero();
   E.leftCols<kD>().setIdentity();
   phi_c_ = MulA<kB>(J, phi_c_) + MulBG<kB>(J, E, with_gravity_);
-  const std::array<double, 8> step = {t_before, gyro.x(), gyro.y(), gyro.z(), acc.x(), acc.y(), acc.z(), dt};
-  if (std::fwrite(step.data(), sizeof(double), step.size(), steps_file_) != step.size()) failed_ = true;
-  ++steps_;
 }
 
 void EskfRts::BeforeUpdate(const EskfNominal& x, const MatP& P) {

@@ -68,8 +68,11 @@ class EskfRts {
 
   // A chain starts at x (initialisation, watchdog re-initialisation): a node that is its own prior.
   void StartChain(const EskfNominal& x, const MatP& P);
-  // One propagation step of the filter (its kernel Jacobians, the rate and specific force it used).
-  void Step(const ImuStepJacobians& J, const Vec3& gyro, const Vec3& acc, double t_before, double dt);
+  // One sample's step of the filter's nominal state (the rate and specific force it used), for the output
+  // bridges between nodes.
+  void RecordStep(const Vec3& gyro, const Vec3& acc, double t_before, double dt);
+  // One step of the filter's covariance (its kernel Jacobians; it may span several samples' steps).
+  void Compound(const ImuStepJacobians& J);
   // Before an accepted update at the filter's current time: opens a node there (unless one is open at
   // this time), with the state before the update as its prior.
   void BeforeUpdate(const EskfNominal& x, const MatP& P);

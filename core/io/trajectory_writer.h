@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdio>
+#include <memory>
 #include <string>
 
 #include "core/geodesy.h"
@@ -24,7 +25,9 @@ class AtomicFile {
   const std::string& path() const { return path_; }
 
  private:
+  static constexpr size_t kBufferSize = 1 << 20;
   std::string path_, tmp_path_;
+  std::unique_ptr<char[]> buffer_;  // the stream's; outlives it (the destructor closes the stream first)
   FILE* file_ = nullptr;
   bool committed_ = false;
 };

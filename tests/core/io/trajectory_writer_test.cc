@@ -84,6 +84,25 @@ TEST(AtomicFile, CommittedFileHasTheContents) {
   EXPECT_EQ(DirEntries(dir), std::vector<std::string>{"out.txt"});
 }
 
+// Contents larger than the stream's own buffer (1 MiB) arrive whole and in order.
+TEST(AtomicFile, LargeContentsArriveWhole) {
+  const std::string dir = test::MakeTempDir("atomic_large");
+  const std::string path = dir + "/out.txt";
+  std::string expected;
+  {
+    AtomicFile f(path);
+    for (int i = 0; i < 200000; ++i) {
+      char line[32];
+      const int n = std::snprintf(line, sizeof(line), "%d,%d\n", i, i * 7);
+      expected.append(line, static_cast<size_t>(n));
+      std::fputs(line, f.stream());
+    }
+    f.Commit();
+  }
+  ASSERT_GT(expected.size(), 2u << 20);
+  EXPECT_EQ(test::ReadFile(path), expected);
+}
+
 TEST(AtomicFile, CommitReplacesAnExistingFile) {
   const std::string dir = test::MakeTempDir("atomic_replace");
   const std::string path = dir + "/out.txt";

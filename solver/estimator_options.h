@@ -14,7 +14,7 @@ struct EskfOptions {
   bool estimate_gravity = true;     // eskf.estimate_gravity: δg in the error state
   double gravity_sigma = 0.01;      // eskf.gravity_sigma_m_s2 initial 1-σ per axis
   int iterations = 3;               // eskf.iterations: at most this many linearisations per update
-  double covariance_interval = 0.0;  // eskf.covariance_interval_s: the covariance steps over up to this long
+  double covariance_interval = 0.02;  // eskf.covariance_interval_s: the covariance steps over up to this long
 };
 
 // smoother.*

@@ -115,12 +115,13 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   x_.p_wb = k.p;
   x_.t = t;
   ++imu_steps_;
-  if (gap) {
+  if (per_sample) {
     if (rts_) rts_->Compound(J);
-    CoastCovariance(dt);
-  } else if (per_sample) {
-    if (rts_) rts_->Compound(J);
-    PropagateCovariance(J, dt);
+    if (gap) {
+      CoastCovariance(dt);
+    } else {
+      PropagateCovariance(J, dt);
+    }
   } else {
     pending_.omega = omega;
     pending_.acc = acc;

@@ -151,6 +151,14 @@ void PrintTable(const std::string& reference, const std::string& frame_text, Ali
                 r.m.outages_scored ? Num(r.m.outage_rms, 3).c_str() : "-");
   }
   std::printf("\n");
+  // The accuracy with GNSS, not hidden by the drift without it.
+  std::printf("  H RMSE outside outages and %g s after each, m\n  %2s %8s %6s %-16s", rows.front().m.outage_settle, "",
+              "", "", "");
+  for (const Row& r : rows) {
+    std::printf(" %*s", static_cast<int>(std::max<size_t>(9, r.label.size())),
+                r.m.rmse_h_outside ? Num(*r.m.rmse_h_outside, 4).c_str() : "-");
+  }
+  std::printf("\n");
 }
 
 // The files to evaluate: the inputs, run directories expanded to their outputs. A run directory's summary
@@ -300,6 +308,7 @@ int Evaluate(const EvalRequest& req) {
   options.segment_length = req.segment_length;
   options.alignment = alignment;
   options.outages = outages;
+  options.outage_settle = req.outage_settle;
 
   // The reference: the truth, else the first trajectory (then not an estimate).
   const std::vector<TrajectorySample> reference =
@@ -351,6 +360,10 @@ CLI::App* AddEvalCommand(CLI::App& app, EvalRequest* req) {
       ->check(CLI::IsMember({"none", "yaw", "se3"}))
       ->capture_default_str();
   eval->add_option("--segment-length", req->segment_length, "Travelled distance of the relative-error segments (m)")
+      ->capture_default_str();
+  eval->add_option("--outage-settle", req->outage_settle,
+                   "Time after each GNSS outage (s) also left out of the horizontal RMSE outside outages")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   eval->add_option("--max-gap", req->max_gap,
                    "Largest estimate gap interpolated across (s); at least 3x the estimate's median interval")

@@ -17,6 +17,7 @@ struct EvalRequest {
   std::string align = "none";       // none | yaw | se3
   double segment_length = 100.0;    // m, relative error
   double max_gap = 1.0;             // s, largest estimate gap interpolated across
+  double outage_settle = 5.0;       // s after each outage also left out of the RMSE outside outages
 };
 
 // Adds the `eval` subcommand to `app`, parsing into *req.

@@ -178,7 +178,7 @@ def merged_windows(summary):
     return out
 
 
-def eval_metrics(ref, est, windows, segment=100.0, min_gap=1.0):
+def eval_metrics(ref, est, windows, segment=100.0, min_gap=1.0, settle=5.0):
     dt = np.diff(est["t"])
     gap = max(min_gap, 3.0 * np.sort(dt)[len(dt) // 2])
     t = ref["t"]
@@ -231,6 +231,12 @@ def eval_metrics(ref, est, windows, segment=100.0, min_gap=1.0):
     scored = [x for x in drifts if x is not None]
     out["outage_drift_rms_m"] = rms(scored) if scored else None
     out["outage_drift_max_m"] = max(scored) if scored else None
+    if windows:  # the horizontal RMSE outside every window and the settle time after it
+        keep = np.ones(len(idx), bool)
+        for a, b, _ in windows:
+            keep &= ~((t[idx] >= a) & (t[idx] <= b + settle))
+        out["outside_outages_samples"] = int(keep.sum())
+        out["rmse_horizontal_outside_outages_m"] = rms(eh[keep]) if keep.any() else None
     return out
 
 
@@ -252,8 +258,9 @@ def compare(args):
     worst, failures = 0.0, []
     print(f"{'trajectory':16s} {'metric':28s} {'numpy':>12s} {'gins eval':>12s} {'rel diff':>9s}")
     for tr in trajs:
-        mine = eval_metrics(ref, tr, windows, ev.get("segment_length_m", 100.0), ev.get("max_gap_s", 1.0))
         theirs = by_path.get(os.path.realpath(tr["path"]))
+        settle = theirs.get("outage_settle_s", 5.0) if theirs else 5.0
+        mine = eval_metrics(ref, tr, windows, ev.get("segment_length_m", 100.0), ev.get("max_gap_s", 1.0), settle)
         if theirs is None:
             print(f"{tr['path']}: not in {args.compare}")
             failures.append(tr["path"])
@@ -261,7 +268,8 @@ def compare(args):
         pairs = [(k, mine[k], theirs.get(k)) for k in
                  ["samples", "rmse_3d_m", "rmse_horizontal_m", "rmse_vertical_m", "rmse_east_m", "rmse_north_m",
                   "mean_horizontal_m", "max_horizontal_m", "rmse_velocity_m_s", "rmse_attitude_deg",
-                  "rmse_heading_deg", "max_heading_deg", "outage_drift_rms_m", "outage_drift_max_m"] if k in mine]
+                  "rmse_heading_deg", "max_heading_deg", "outage_drift_rms_m", "outage_drift_max_m",
+                  "outside_outages_samples", "rmse_horizontal_outside_outages_m"] if k in mine]
         for k in ["segments", "mean_percent", "rms_percent", "max_percent"]:
             pairs.append(("relative_error." + k, mine["relative_error"][k], theirs["relative_error"][k]))
         for i, x in enumerate(mine["outages"]):

@@ -54,6 +54,11 @@ nlohmann::json MetricsToJson(const TrajectoryMetrics& m, double time_origin) {
   j["outages_scored"] = m.outages_scored;
   j["outage_drift_rms_m"] = m.outages_scored ? nlohmann::json(m.outage_rms) : nlohmann::json();
   j["outage_drift_max_m"] = m.outages_scored ? nlohmann::json(m.outage_max) : nlohmann::json();
+  if (!m.outages.empty()) {
+    j["outage_settle_s"] = m.outage_settle;
+    j["outside_outages_samples"] = m.outside_samples;
+    j["rmse_horizontal_outside_outages_m"] = m.rmse_h_outside ? nlohmann::json(*m.rmse_h_outside) : nlohmann::json();
+  }
   nlohmann::json align;
   align["kind"] = AlignmentName(m.alignment);
   if (m.alignment != Alignment::kNone) {

@@ -281,11 +281,15 @@ void TrajectoryEvaluator::AddPair(const TrajectorySample& ref, const TrajectoryS
     open_segments_.push_back({travelled_, est.p_w, ref.p_w});
   }
 
-  // Drift over outages: the windows holding this time.
+  // Drift over outages: the windows holding this time; and the error outside them and their settle times.
   while (next_window_ < by_begin_.size() && options_.outages[by_begin_[next_window_]].begin <= ref.t) {
     open_windows_.push_back(by_begin_[next_window_++]);
   }
+  const double settle = options_.outage_settle;
+  bool outside = true;
   for (size_t w : open_windows_) {
+    if (ref.t > options_.outages[w].end + settle) continue;
+    outside = false;
     if (ref.t > options_.outages[w].end) continue;
     OutageDrift& o = outages_[w];
     if (o.samples == 0 || err_h > o.max_h) {
@@ -296,8 +300,12 @@ void TrajectoryEvaluator::AddPair(const TrajectorySample& ref, const TrajectoryS
     ++o.samples;
   }
   open_windows_.erase(std::remove_if(open_windows_.begin(), open_windows_.end(),
-                                     [&](size_t w) { return ref.t > options_.outages[w].end; }),
+                                     [&](size_t w) { return ref.t > options_.outages[w].end + settle; }),
                       open_windows_.end());
+  if (outside) {
+    s_outside_h_ += err_h * err_h;
+    ++outside_;
+  }
 }
 
 TrajectoryMetrics TrajectoryEvaluator::Metrics() const {
@@ -339,6 +347,11 @@ TrajectoryMetrics TrajectoryEvaluator::Metrics() const {
     m.outage_max = std::max(m.outage_max, o.max_h);
   }
   if (m.outages_scored > 0) m.outage_rms = std::sqrt(outage_sq / static_cast<double>(m.outages_scored));
+  m.outage_settle = options_.outage_settle;
+  if (!outages_.empty()) {
+    m.outside_samples = outside_;
+    if (outside_ > 0) m.rmse_h_outside = std::sqrt(s_outside_h_ / static_cast<double>(outside_));
+  }
   return m;
 }
 

@@ -19,6 +19,9 @@
 // - Outage drift: for each window [begin, end], the largest horizontal error of the pairs inside it (not
 //   reduced by the error at its start: with RTK that is centimetres); RMS and max over the windows that
 //   have pairs.
+// - Horizontal RMSE outside outages: over the pairs in no window [begin, end + outage_settle] (the settle
+//   time leaves out the re-convergence after each outage), so the accuracy with GNSS is not hidden by the
+//   drift without it. Only when there are windows.
 // - Alignment (off by default; for inputs that are not geo-referenced): the rigid transform of the
 //   estimate minimising Σ|R p_est + t − p_ref|² over the pairs: yaw + translation (4-DoF) or full SE(3)
 //   (Umeyama, no scale). It is applied to positions, attitudes and velocities before every metric.
@@ -101,6 +104,7 @@ struct MetricOptions {
   double segment_length = 100.0;  // m
   Alignment alignment = Alignment::kNone;
   std::vector<TimeWindow> outages;  // absolute times
+  double outage_settle = 5.0;       // s after each outage's end still left out of the RMSE outside outages
 };
 
 // One evaluated reference time.
@@ -156,6 +160,11 @@ struct TrajectoryMetrics {
   std::vector<OutageDrift> outages;
   uint64_t outages_scored = 0;
   double outage_rms = 0.0, outage_max = 0.0;
+  // Horizontal RMSE over the pairs outside every window and its settle time; set when there are windows
+  // and such pairs.
+  double outage_settle = 0.0;
+  uint64_t outside_samples = 0;
+  std::optional<double> rmse_h_outside;
   Alignment alignment = Alignment::kNone;
   RigidTransform align;  // applied to the estimate (identity without alignment)
 };
@@ -204,11 +213,13 @@ class TrajectoryEvaluator {
   uint64_t segments_ = 0;
   double rel_sum_ = 0.0, rel_sq_ = 0.0, rel_max_ = 0.0;
   // Outage drift, per window of options_.outages; windows are opened in order of their begin and closed
-  // once the reference passes their end.
+  // once the reference passes their end plus the settle time.
   std::vector<OutageDrift> outages_;
   std::vector<size_t> by_begin_;  // window indices sorted by begin
   size_t next_window_ = 0;        // into by_begin_: the first window not yet opened
   std::vector<size_t> open_windows_;
+  uint64_t outside_ = 0;
+  double s_outside_h_ = 0.0;  // sum of squared horizontal errors outside windows and settle times
 };
 
 // The metrics over trajectories in memory: EffectiveMaxGap, FitAlignment over MatchAtReferenceTimes when

@@ -153,6 +153,14 @@ TEST_F(EvalKnownAnswers, OffsetsAndRotationsAgainstTruth) {
   EXPECT_TRUE(a["outages"][2]["max_horizontal_m"].is_null());
   EXPECT_EQ(a["outages_scored"].get<int>(), 2);
   EXPECT_NEAR(a["outage_drift_rms_m"].get<double>(), 5.0, 1e-4);
+  // Outside the windows and 5 s after each: 500 − 151 (10-25 s) − 106 (30-40.5 s) truth times.
+  EXPECT_EQ(a["outside_outages_samples"].get<int>(), 243);
+  EXPECT_NEAR(a["rmse_horizontal_outside_outages_m"].get<double>(), 5.0, 1e-4);
+  EXPECT_EQ(a["outage_settle_s"].get<double>(), 5.0);
+
+  // --outage-settle: 10-22.05 s and 30-37.55 s left out.
+  ASSERT_EQ(Cli({"eval", "--truth", truth_, "--summary", summary_, "--outage-settle", "2.05", "--json", out, offset_}), 0);
+  EXPECT_EQ(Json(out)["trajectories"][0]["outside_outages_samples"].get<int>(), 500 - 121 - 76);
 
   const auto& b = j["trajectories"][1];
   EXPECT_EQ(b["name"], "tum");

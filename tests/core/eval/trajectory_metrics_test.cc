@@ -213,6 +213,39 @@ TEST(TrajectoryMetrics, OutageDrift) {
   EXPECT_NEAR(m.max_h, 2.0, 1e-9);
 }
 
+TEST(TrajectoryMetrics, RmseOutsideOutagesLeavesOutWindowsAndTheirSettleTime) {
+  const auto ref = Drive(100.0, 0.125);
+  // 0.3 m north everywhere but in [20, 40] s (2 m), the 5 s after it (1 m) and [60, 75] s (4 m).
+  auto est = ref;
+  for (auto& x : est) {
+    const double s = x.t - kT0;
+    x.p_w.y() += (s >= 20.0 && s <= 40.0) ? 2.0 : (s > 40.0 && s <= 45.0) ? 1.0 : (s >= 60.0 && s <= 75.0) ? 4.0 : 0.3;
+  }
+  MetricOptions o;
+  o.outages = {{kT0 + 60.0, kT0 + 70.0, "log gap"}, {kT0 + 20.0, kT0 + 40.0, "config"}};  // unsorted
+  TrajectoryMetrics m = EvaluateTrajectory(ref, true, est, true, o);
+  ASSERT_TRUE(m.rmse_h_outside.has_value());
+  EXPECT_NEAR(*m.rmse_h_outside, 0.3, 1e-9);
+  EXPECT_EQ(m.outside_samples, 801u - 201u - 121u);  // [20, 45] and [60, 75] s at 8 Hz left out
+  EXPECT_DOUBLE_EQ(m.outage_settle, 5.0);
+  EXPECT_NEAR(m.outages[1].max_h, 2.0, 1e-9);  // the drift is still the window's own
+
+  // Without a settle time the 1 m after the first window counts (40 samples in (40, 45]) and the last 4 m
+  // stretch (40 samples in (70, 75]).
+  o.outage_settle = 0.0;
+  m = EvaluateTrajectory(ref, true, est, true, o);
+  EXPECT_EQ(m.outside_samples, 801u - 161u - 81u);
+  EXPECT_NEAR(*m.rmse_h_outside, std::sqrt((479.0 * 0.09 + 40.0 * 1.0 + 40.0 * 16.0) / 559.0), 1e-9);
+
+  // No windows: nothing to leave out, and no number.
+  EXPECT_FALSE(EvaluateTrajectory(ref, true, est, true, NoOutages()).rmse_h_outside.has_value());
+  // Every pair inside a window: no number either.
+  o.outages = {{kT0 - 1.0, kT0 + 200.0, "config"}};
+  m = EvaluateTrajectory(ref, true, est, true, o);
+  EXPECT_EQ(m.outside_samples, 0u);
+  EXPECT_FALSE(m.rmse_h_outside.has_value());
+}
+
 TEST(TrajectoryMetrics, MergeWindows) {
   const auto w = MergeWindows({{30.0, 40.0, "config"}, {10.0, 20.0, "config"}, {35.0, 50.0, "log gap"},
                                {50.0, 55.0, "config"}, {60.0, 61.0, "log gap"}});
@@ -422,6 +455,22 @@ TrajectoryMetrics Evaluate(const std::vector<TrajectorySample>& reference, bool 
     m.outages.push_back(o);
   }
   if (m.outages_scored > 0) m.outage_rms = std::sqrt(outage_sq / static_cast<double>(m.outages_scored));
+
+  m.outage_settle = options.outage_settle;
+  if (!options.outages.empty()) {
+    double outside_sq = 0.0;
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      const double t = pairs[i].ref.t;
+      if (std::any_of(options.outages.begin(), options.outages.end(), [&](const TimeWindow& w) {
+            return t >= w.begin && t <= w.end + options.outage_settle;
+          })) {
+        continue;
+      }
+      outside_sq += err_h[i] * err_h[i];
+      ++m.outside_samples;
+    }
+    if (m.outside_samples > 0) m.rmse_h_outside = std::sqrt(outside_sq / static_cast<double>(m.outside_samples));
+  }
   return m;
 }
 
@@ -466,6 +515,9 @@ void ExpectSameMetrics(const TrajectoryMetrics& a, const TrajectoryMetrics& b) {
   EXPECT_EQ(a.outages_scored, b.outages_scored);
   same(a.outage_rms, b.outage_rms, "outage_rms");
   same(a.outage_max, b.outage_max, "outage_max");
+  EXPECT_EQ(a.outside_samples, b.outside_samples);
+  ASSERT_EQ(a.rmse_h_outside.has_value(), b.rmse_h_outside.has_value());
+  if (a.rmse_h_outside) same(*a.rmse_h_outside, *b.rmse_h_outside, "rmse_h_outside");
   EXPECT_EQ(a.alignment, b.alignment);
   EXPECT_LT((a.align.R - b.align.R).norm(), 1e-12);
   EXPECT_LT((a.align.t - b.align.t).norm(), 1e-9);
@@ -539,6 +591,7 @@ TEST(TrajectoryEvaluator, EqualsTheWholeTrajectoryOracle) {
       o.alignment = alignment;
       o.segment_length = segment_length;
       o.outages = ScenarioOutages();
+      o.outage_settle = segment_length == 7.0 ? 0.0 : 5.0;
       const TrajectoryMetrics want = oracle::Evaluate(sc.reference, true, sc.estimate, true, o);
       const TrajectoryMetrics got = EvaluateTrajectory(sc.reference, true, sc.estimate, true, o);
       ExpectSameMetrics(got, want);
@@ -551,6 +604,8 @@ TEST(TrajectoryEvaluator, EqualsTheWholeTrajectoryOracle) {
       EXPECT_EQ(got.outages[1].samples, 0u);
       EXPECT_GT(got.outages[4].samples, 300u);  // in the standstill
       EXPECT_EQ(got.outages[6].samples, 1u);    // one reference time, inside the 0.5 s hole
+      EXPECT_GT(got.outside_samples, 1000u);
+      EXPECT_LT(got.outside_samples + 300u, got.samples);
     }
   }
   // Without velocities on one side; the estimate as the reference of the other (an estimate vs an estimate).

@@ -355,14 +355,15 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
     }
     if (options_.wheel.enabled && options_.wheel.estimate_scale) P_(eskf::kS, eskf::kS) = std::pow(options_.wheel.scale_sigma, 2);
   }
-  const bool have_velocity = ResetPositionFromFix(m, prev_fix_, options_, &x_, P_);
+  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &x_, P_, reset_waits_for_course_);
+  reset_waits_for_course_ = false;
   P_ = 0.5 * (P_ + P_.transpose());
   gyro_sum_.setZero();
   gyro_count_ = 0;
   gyro_sum_start_ = m.t;
   watchdog_.Reset(m.t, reason);
-  LOG(WARNING) << "eskf watchdog: re-initialised from GNSS at t=" << std::fixed << m.t << " (" << reason
-               << (have_velocity ? "; velocity from the last two fixes" : "; velocity kept") << ")";
+  LOG(WARNING) << "eskf watchdog: re-initialised from GNSS at t=" << std::fixed << m.t << " (" << reason << "; "
+               << Describe(how) << ")";
   if (rts_) rts_->StartChain(Nominal(), P_);
   if (on_state_) on_state_(Estimate());
 }

@@ -34,8 +34,13 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
     FlushCovariance();
     const double max_sigma = options_.watchdog.max_position_sigma;
     const bool finite = x_.AllFinite() && P_.allFinite() && dg_w_.allFinite() && std::isfinite(scale_);
-    if (!finite || BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
-      ResetFromGnss(m, finite ? "covariance" : "non_finite");
+    if (reset_waits_for_course_ || !finite || BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
+      // A lost yaw waits for the next fix's course rather than being kept (ResetWaitsForCourse).
+      if (finite && !reset_waits_for_course_ && ResetWaitsForCourse(m, prev_fix_, options_, x_, P_)) {
+        reset_waits_for_course_ = true;
+      } else {
+        ResetFromGnss(m, finite ? "covariance" : "non_finite");
+      }
       prev_fix_ = m;
       return;
     }

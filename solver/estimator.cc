@@ -15,17 +15,98 @@ constexpr double kResetVelSigma = 1.0;        // m/s, velocity from two fixes
 constexpr double kResetKeptVelSigma = 2.0;    // m/s, velocity kept from the diverged estimate
 constexpr double kResetMaxFixInterval = 2.0;  // s, longest interval of two fixes giving the velocity
 constexpr double kResetMinYawSigma = 2.0 * kDegToRad;  // a diverged estimate may have a wrong yaw
+// Beyond this yaw 1-σ the error-state model's linearisation no longer holds (a 20° yaw error puts a third
+// of the speed across the track): such a yaw is lost, not kept.
+constexpr double kResetLostYawSigma = 20.0 * kDegToRad;
 }  // namespace
 
-bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                          const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P) {
+namespace {
+
+bool RecentFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix) {
+  return prev_fix && m.t - prev_fix->t > 0.0 && m.t - prev_fix->t <= kResetMaxFixInterval;
+}
+
+// Variance of the yaw (rotation about world up) in a body-frame attitude covariance.
+double YawVariance(const Quat& q_wb, const Eigen::Ref<const MatX>& P) {
+  const Vec3 z_b = q_wb.conjugate() * Vec3::UnitZ();
+  return z_b.dot(P.block<3, 3>(nav::kTheta, nav::kTheta) * z_b);
+}
+
+bool YawLost(const Quat& q_wb, const Eigen::Ref<const MatX>& P) {
+  return !(YawVariance(q_wb, P) <= kResetLostYawSigma * kResetLostYawSigma);  // NaN too
+}
+
+bool HeadingUsable(const GnssMeasurement& m, const EstimatorOptions& options) {
+  return m.heading_valid && options.gnss.use_heading && std::isfinite(m.yaw_G);
+}
+
+// The course of the two fixes as the yaw of a car's body x axis, with its 1-σ; none when the fixes are not
+// recent or the vehicle moves too slowly between them for a course within about 20°.
+std::optional<std::pair<double, double>> CourseOf(const GnssMeasurement& m,
+                                                  const std::optional<GnssMeasurement>& prev_fix) {
+  if (!RecentFix(m, prev_fix)) return std::nullopt;
+  const double dt = m.t - prev_fix->t;
+  const Vec3 v = (m.p_w - prev_fix->p_w) / dt;
+  const double speed = v.head<2>().norm();
+  const double sigma_v = std::hypot(m.sigma_w.head<2>().maxCoeff(), prev_fix->sigma_w.head<2>().maxCoeff()) / dt;
+  if (!(speed > 3.0 * sigma_v)) return std::nullopt;
+  return std::make_pair(std::atan2(v.y(), v.x()), sigma_v / speed);
+}
+
+}  // namespace
+
+bool ResetWaitsForCourse(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
+                         const EstimatorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P) {
+  return options.vehicle.nonholonomic && !RecentFix(m, prev_fix) && !HeadingUsable(m, options) &&
+         x.q_wb.coeffs().allFinite() && YawLost(x.q_wb, P);
+}
+
+std::string Describe(const FixReset& r) {
+  std::string s = r.velocity_from_fixes ? "velocity from the last two fixes" : "velocity kept";
+  if (std::string(r.yaw) == "heading") s += ", yaw from the dual-antenna heading";
+  if (std::string(r.yaw) == "course") s += ", yaw from the course of the two fixes";
+  return s;
+}
+
+FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
+                              const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P, bool yaw_lost_before) {
+  FixReset result;
+  // A lost yaw is replaced before the lever arm is applied: the arm turns with the body.
+  const bool yaw_lost = yaw_lost_before || YawLost(x->q_wb, P);
+  std::optional<std::pair<double, double>> yaw;  // the new yaw and its 1-σ
+  if (yaw_lost && HeadingUsable(m, options)) {
+    yaw = std::make_pair(m.yaw_G - options.gnss.mount_yaw, m.sigma_yaw);
+    result.yaw = "heading";
+  } else if (yaw_lost && options.vehicle.nonholonomic) {
+    yaw = CourseOf(m, prev_fix);
+    if (yaw) result.yaw = "course";
+  }
+  if (yaw) {
+    // Turn the body about world up onto the new yaw (roll and pitch kept); the attitude covariance becomes
+    // the level part it had (at most the fallback's) and the new yaw's variance, uncorrelated with the rest.
+    // A kept velocity turns with it: the car still moves along its body axis at the speed it had.
+    const Quat turn = QuatFromYaw(yaw->first - YawOfXAxis<double>(x->q_wb.toRotationMatrix()));
+    x->q_wb = (turn * x->q_wb).normalized();
+    x->v_w = turn * x->v_w;
+    const Mat3 fallback = FallbackCovariance(options).block<3, 3>(nav::kTheta, nav::kTheta);
+    const Mat3 P_att = P.block<3, 3>(nav::kTheta, nav::kTheta);
+    const double level_var = std::min(std::max(P_att(0, 0), P_att(1, 1)), fallback(0, 0));
+    const Vec3 z_b = x->q_wb.conjugate() * Vec3::UnitZ();
+    const double yaw_var = std::pow(std::max(yaw->second, kResetMinYawSigma), 2);
+    P.middleRows(nav::kTheta, 3).setZero();
+    P.middleCols(nav::kTheta, 3).setZero();
+    P.block<3, 3>(nav::kTheta, nav::kTheta) = (std::isfinite(level_var) ? level_var : fallback(0, 0)) *
+                                                   (Mat3::Identity() - z_b * z_b.transpose()) +
+                                               yaw_var * z_b * z_b.transpose();
+  }
   x->t = m.t;
   x->p_wb = m.p_w - x->q_wb * options.gnss.lever_b;
   bool have_velocity = false;
-  if (prev_fix && m.t - prev_fix->t > 0.0 && m.t - prev_fix->t <= kResetMaxFixInterval) {
+  if (RecentFix(m, prev_fix)) {
     x->v_w = (m.p_w - prev_fix->p_w) / (m.t - prev_fix->t);
     have_velocity = true;
   }
+  result.velocity_from_fixes = have_velocity;
   // A kept velocity keeps the σ it had (a long coast's is large), at least kResetKeptVelSigma.
   const double kept_sigma_v = std::sqrt(P.block<3, 3>(nav::kV, nav::kV).diagonal().maxCoeff());
   for (int k : {nav::kP, nav::kV}) {
@@ -51,10 +132,10 @@ bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeas
     P.block<3, 3>(nav::kTheta, nav::kTheta).diagonal() = capped.array().isFinite().select(capped, fallback.diagonal());
   }
   const Vec3 z_b = x->q_wb.conjugate() * Vec3::UnitZ();
-  const double yaw_var = z_b.dot(P.block<3, 3>(nav::kTheta, nav::kTheta) * z_b);
+  const double yaw_var = YawVariance(x->q_wb, P);
   const double min_yaw_var = kResetMinYawSigma * kResetMinYawSigma;
   if (yaw_var < min_yaw_var) P.block<3, 3>(nav::kTheta, nav::kTheta) += (min_yaw_var - yaw_var) * z_b * z_b.transpose();
-  return have_velocity;
+  return result;
 }
 
 Quat FallbackAttitude(const GnssMeasurement& m, const EstimatorOptions& options) {

@@ -131,9 +131,25 @@ Mat15 FallbackCovariance(const EstimatorOptions& options);
 // covariance, uncorrelated with the rest; the yaw variance is raised to at least (2°)², since a
 // diverged estimate may have a wrong yaw. P is the covariance in NavState tangent order (its first 15 rows
 // and columns; more, e.g. the ESKF's gravity and scale, are left but decorrelated from δp and δv).
-// Returns whether the velocity came from the fixes.
-bool ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                          const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P);
+// When the yaw is lost (its 1-σ beyond 20°, where the linearisation fails: a long coast, e.g. a logger
+// pause), it is not kept: it comes from the fix's dual-antenna heading, else, for a car (vehicle.nonholonomic: it drives
+// along its body x axis), from the course of the two fixes, as a moving start would take it.
+struct FixReset {
+  bool velocity_from_fixes = false;
+  const char* yaw = "kept";  // "kept" | "heading" | "course"
+};
+// `yaw_lost`: the estimator found the yaw lost at an earlier fix and waited for this one (ResetWaitsForCourse);
+// the updates in between may have shrunk its variance, not made it right.
+FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
+                              const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P,
+                              bool yaw_lost = false);
+// A reset at m would keep a lost yaw that the next fix can give (ResetPositionFromFix): the estimator
+// waits for that fix instead, a second at most on a 1 Hz receiver, and resets there with yaw_lost set.
+// P as above, at m's time.
+bool ResetWaitsForCourse(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
+                         const EstimatorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P);
+// The log line's words for a reset.
+std::string Describe(const FixReset& r);
 
 class Estimator {
  public:

@@ -303,8 +303,13 @@ void Smoother::AddGnss(const GnssMeasurement& m) {
     const Mat15 P = NavCovariance(window_.EstimatedTypes(), p.cov);
     const double sigma_p = std::sqrt(P.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
     const bool finite = window_.back().State().AllFinite() && pred_.AllFinite() && std::isfinite(sigma_p);
-    if (!finite || last_sigma_p_ > max_sigma || sigma_p > max_sigma) {
-      ResetFromGnss(m, finite ? "covariance" : "non_finite");
+    if (reset_waits_for_course_ || !finite || last_sigma_p_ > max_sigma || sigma_p > max_sigma) {
+      // A lost yaw waits for the next fix's course rather than being kept (ResetWaitsForCourse).
+      if (finite && !reset_waits_for_course_ && ResetWaitsForCourse(m, prev_fix_, options_, p.x, P)) {
+        reset_waits_for_course_ = true;
+      } else {
+        ResetFromGnss(m, finite ? "covariance" : "non_finite");
+      }
       prev_fix_ = m;
       return;
     }
@@ -329,7 +334,9 @@ void Smoother::WatchGnss(double t, bool accepted) {
 
 void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason_in) {
   const std::string reason = reason_in;  // may be reset_reason_, which is cleared below
-  IntegrateTo(m.t);  // attitude and biases at the fix's time (pred_), from the newest keyframe
+  // Attitude and biases at the fix's time (pred_), from the newest keyframe, with the covariance predicted
+  // there: after a long coast (a logger pause) the yaw is lost, and the reset must see it.
+  const Prediction at_fix_prediction = PredictAt(m.t);
   const NavState at_fix = pred_;
   // What the window knows of the newest keyframe: its state, and its covariance from the whole window.
   InitResult init;
@@ -337,9 +344,15 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
   bool have_cov = false;
   const bool finite = window_.back().State().AllFinite();
   if (finite) {
+    const std::vector<BlockType> types = window_.EstimatedTypes();
     // The older keyframes leave the window as usual (final output); the newest is replaced by the prior.
     while (window_.size() > 1) MarginalizeOldest(nullptr);
-    have_cov = OldestCovariance(window_, &cov);
+    if (at_fix_prediction.cov.rows() == static_cast<int>(NavIndexOfTangent(types).size()) && at_fix_prediction.cov.allFinite()) {
+      cov = NavCovariance(types, at_fix_prediction.cov);
+      have_cov = true;
+    } else {
+      have_cov = OldestCovariance(window_, &cov);
+    }
     init.x0 = at_fix.AllFinite() ? at_fix : window_.front().State();
     initial_scale_ = window_.front().block(BlockType::kScale)[0];
   } else {
@@ -349,7 +362,8 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
   if (!have_cov) cov = FallbackCovariance(options_);
   init.g_norm = earth_.g_norm();
   init.earth = earth_;
-  const bool have_velocity = ResetPositionFromFix(m, prev_fix_, options_, &init.x0, cov);
+  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &init.x0, cov, reset_waits_for_course_);
+  reset_waits_for_course_ = false;
   // Tiny floors keep the prior invertible whatever the window's covariance was.
   cov = 0.5 * (cov + cov.transpose());
   cov.diagonal() = cov.diagonal().cwiseMax(1e-12);
@@ -367,7 +381,7 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
   reset_reason_.clear();
   watchdog_.Reset(m.t, reason);
   LOG(WARNING) << "smoother watchdog: window rebuilt from GNSS at t=" << std::fixed << m.t << " (" << reason
-               << (have_velocity ? "; velocity from the last two fixes" : "; velocity kept") << ")";
+               << "; " << Describe(how) << ")";
 }
 
 bool Smoother::Solve() {

@@ -3,6 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "core/so3.h"
+
 namespace gins {
 namespace {
 
@@ -19,6 +24,103 @@ TEST(MeasurementCounts, OfferedIsUsedPlusEveryRejection) {
   EXPECT_EQ(j["offered"].get<uint64_t>(), 10u);
   EXPECT_EQ(j["rejected_times"].size(), 3u);
   EXPECT_EQ(MeasurementCounts().ToJson()["offered"].get<uint64_t>(), 0u);
+}
+
+// The watchdog's re-initialisation from a fix (ResetPositionFromFix, ResetWaitsForCourse).
+class FixResetTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    options_.gnss.lever_b = Vec3(-0.17, -0.20, 0.3);
+    options_.gnss.mount_yaw = 12.0 * kDegToRad;
+    options_.gnss.use_heading = true;
+    options_.vehicle.nonholonomic = true;
+    // Level but for a small roll, yaw 0, the velocity of a minute ago along the body axis.
+    x_.q_wb = Quat(Eigen::AngleAxisd(0.02, Vec3::UnitX()));
+    x_.v_w = Vec3(5.0, 0.0, 0.0);
+    P_ = MatX::Identity(15, 15) * 1e-4;
+    fix_.t = 100.0;
+    fix_.p_w = Vec3(10.0, 20.0, 1.0);
+    fix_.sigma_w = Vec3(0.02, 0.02, 0.03);
+    prev_ = fix_;
+    prev_.t = 99.0;
+    prev_.p_w = fix_.p_w - Vec3(0.0, 10.0, 0.0);  // 10 m/s due north
+  }
+  // The yaw's 1-σ (about world up) in P.
+  double YawSigma(const NavState& x, const MatX& P) const {
+    const Vec3 z_b = x.q_wb.conjugate() * Vec3::UnitZ();
+    return std::sqrt(z_b.dot(P.block<3, 3>(nav::kTheta, nav::kTheta) * z_b));
+  }
+  void LoseYaw(double sigma) { P_.block<3, 3>(nav::kTheta, nav::kTheta).diagonal() << 1e-4, 1e-4, sigma * sigma; }
+  EstimatorOptions options_;
+  NavState x_;
+  MatX P_;
+  GnssMeasurement fix_, prev_;
+};
+
+TEST_F(FixResetTest, LostYawComesFromTheDualAntennaHeading) {
+  LoseYaw(1.0);
+  fix_.heading_valid = true;
+  fix_.yaw_G = 1.0 + options_.gnss.mount_yaw;
+  fix_.sigma_yaw = 0.2 * kDegToRad;
+  const FixReset r = ResetPositionFromFix(fix_, std::nullopt, options_, &x_, P_);
+  EXPECT_STREQ(r.yaw, "heading");
+  EXPECT_FALSE(r.velocity_from_fixes);
+  EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 1.0, 1e-12);
+  EXPECT_NEAR((x_.q_wb.conjugate() * Vec3::UnitZ()).y(), std::sin(0.02), 1e-12);  // the roll is kept
+  EXPECT_NEAR(YawSigma(x_, P_), 2.0 * kDegToRad, 1e-9);  // the heading's σ, raised to the 2° floor
+  EXPECT_LT((x_.v_w - Vec3(5.0 * std::cos(1.0), 5.0 * std::sin(1.0), 0.0)).norm(), 1e-12);  // turned with it
+  EXPECT_LT((x_.p_wb + x_.q_wb * options_.gnss.lever_b - fix_.p_w).norm(), 1e-12);  // the arm at the new yaw
+  EXPECT_TRUE(Eigen::SelfAdjointEigenSolver<MatX>(P_).eigenvalues().minCoeff() > 0.0);
+}
+
+TEST_F(FixResetTest, LostYawOfACarComesFromTheCourseOfTwoFixes) {
+  LoseYaw(1.0);
+  const FixReset r = ResetPositionFromFix(fix_, prev_, options_, &x_, P_);
+  EXPECT_STREQ(r.yaw, "course");
+  EXPECT_TRUE(r.velocity_from_fixes);
+  EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 0.5 * M_PI, 1e-12);
+  EXPECT_LT((x_.v_w - Vec3(0.0, 10.0, 0.0)).norm(), 1e-12);
+  EXPECT_NEAR(YawSigma(x_, P_), 2.0 * kDegToRad, 1e-9);  // course σ 0.028/10 rad, raised to the floor
+  // Too slow for a course (speed below 3 σ of the fixes' velocity): the yaw is kept, σ capped to the fallback.
+  LoseYaw(1.0);
+  x_.q_wb = Quat::Identity();
+  prev_.p_w = fix_.p_w - Vec3(0.0, 0.05, 0.0);
+  EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, options_, &x_, P_).yaw, "kept");
+  EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 0.0, 1e-12);
+}
+
+TEST_F(FixResetTest, AKnownYawIsKept) {
+  LoseYaw(10.0 * kDegToRad);  // within 20°: the linearisation holds
+  fix_.heading_valid = true;
+  fix_.yaw_G = 1.0;
+  const FixReset r = ResetPositionFromFix(fix_, prev_, options_, &x_, P_);
+  EXPECT_STREQ(r.yaw, "kept");
+  EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 0.0, 1e-12);
+  EXPECT_NEAR(YawSigma(x_, P_), 10.0 * kDegToRad, 1e-4);  // about world up, the body rolled 0.02 rad
+  // Lost, but not a car: the course says nothing of the yaw.
+  LoseYaw(1.0);
+  options_.vehicle.nonholonomic = false;
+  fix_.heading_valid = false;
+  EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, options_, &x_, P_).yaw, "kept");
+}
+
+TEST_F(FixResetTest, WaitsForTheCourseOnlyWhenTheNextFixCanGiveTheYaw) {
+  LoseYaw(1.0);
+  EXPECT_TRUE(ResetWaitsForCourse(fix_, std::nullopt, options_, x_, P_));
+  prev_.t = fix_.t - 60.0;  // the fix before the pause is too old for a course
+  EXPECT_TRUE(ResetWaitsForCourse(fix_, prev_, options_, x_, P_));
+  prev_.t = fix_.t - 1.0;  // a recent one gives it now
+  EXPECT_FALSE(ResetWaitsForCourse(fix_, prev_, options_, x_, P_));
+  GnssMeasurement with_heading = fix_;
+  with_heading.heading_valid = true;
+  EXPECT_FALSE(ResetWaitsForCourse(with_heading, std::nullopt, options_, x_, P_));
+  options_.gnss.use_heading = false;  // a heading the config says not to use does not count
+  EXPECT_TRUE(ResetWaitsForCourse(with_heading, std::nullopt, options_, x_, P_));
+  options_.vehicle.nonholonomic = false;
+  EXPECT_FALSE(ResetWaitsForCourse(fix_, std::nullopt, options_, x_, P_));
+  options_.vehicle.nonholonomic = true;
+  LoseYaw(10.0 * kDegToRad);
+  EXPECT_FALSE(ResetWaitsForCourse(fix_, std::nullopt, options_, x_, P_));
 }
 
 }  // namespace

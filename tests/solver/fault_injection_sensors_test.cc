@@ -128,12 +128,13 @@ TEST(FaultInjection, HeadingValidButConstant) {
   ExpectRecovery("heading valid but constant", run, run.init_t, run.init_t + 5.0, sim.start_time + 120.0, 0.0);
 }
 
-// The logger pauses: no record of any type for 1, 2, 5 and 10 s while driving (from 50 s). Expected: both
+// The logger pauses: no record of any type for 1, 2, 5, 10 and 60 s while driving (from 50 s). Expected: both
 // coast across the IMU gap (counted) with the uncertainty of an unknown motion (estimator.h, kImuGap*); at
-// the first fix after it the position σ has grown past the fixes' error, so the fix is taken; within the
-// bound 5 s after the records return. (A pause of 60 s is pending: fault_injection_pending.cc.txt.)
+// the first fix after it the position σ has grown past the fixes' error, so the fix is taken (after 60 s,
+// past watchdog.max_position_sigma_m: a re-initialisation from it, the lost yaw from the dual-antenna
+// heading); within the bound 5 s after the records return.
 TEST(FaultInjection, LoggerPause) {
-  for (double d : {1.0, 2.0, 5.0, 10.0}) {
+  for (double d : {1.0, 2.0, 5.0, 10.0, 60.0}) {
     SCOPED_TRACE("pause " + std::to_string(d) + " s");
     const SimOptions sim = FaultDrive(25, 140.0);
     const double t0 = sim.start_time + 50.0, t1 = t0 + d;
@@ -144,6 +145,31 @@ TEST(FaultInjection, LoggerPause) {
     test::ExpectSaneOutputs(run);
     ExpectRecovery("logger pause " + std::to_string(static_cast<int>(d)) + " s", run, t0, t1, sim.start_time + 140.0,
                    5.0);
+  }
+}
+
+// A 60 s logger pause on a log whose fixes carry no heading (gnss.use_heading: false). Expected: at the first
+// fix after it the yaw is lost (σ far beyond 20°), and there is no heading to take it from: both wait for
+// the next fix (a second), then re-initialise with velocity and yaw from the two fixes' course (a car
+// drives along its body axis); within the bound 5 s after the records return. Without NHC (not a car)
+// the course says nothing of the yaw, and the reset keeps it, as before.
+TEST(FaultInjection, LongLoggerPauseWithoutHeading) {
+  const SimOptions sim = FaultDrive(25, 140.0);
+  Options options = test::TestRunOptions(sim);
+  options.gnss.use_heading = false;
+  const double t0 = sim.start_time + 50.0, t1 = t0 + 60.0;
+  const DriveRun run = test::RunDriveThroughSession(sim, options, Editing([&](SimRecord* r) {
+    return !(r->t() > t0 && r->t() < t1);
+  }));
+  ASSERT_TRUE(run.initialized);
+  test::ExpectSaneOutputs(run);
+  ExpectRecovery("logger pause 60 s, no heading", run, t0, t1, sim.start_time + 140.0, 5.0);
+  for (const char* name : {"eskf", "smoother"}) {
+    SCOPED_TRACE(name);
+    const nlohmann::json& resets = run.stats["estimators"][name]["watchdog"]["resets"];
+    ASSERT_GE(resets.size(), 1u);
+    EXPECT_NEAR(resets[0]["time"].get<double>(), t1 + 1.0, 1e-6);  // the second fix after the pause
+    EXPECT_EQ(resets[0]["reason"], "covariance");
   }
 }
 

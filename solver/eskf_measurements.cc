@@ -41,6 +41,7 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
       } else {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
       }
+      ++gnss_counts_.used;  // the re-initialisation's fix (or the one held for its course): offered stays every fix
       prev_fix_ = m;
       return;
     }

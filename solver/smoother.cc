@@ -310,6 +310,7 @@ void Smoother::AddGnss(const GnssMeasurement& m) {
       } else {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
       }
+      for (auto& attacher : attachers_) attacher->OnResetFix(m);  // counted as used: offered stays every fix
       prev_fix_ = m;
       return;
     }

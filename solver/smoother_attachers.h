@@ -103,6 +103,8 @@ class MeasurementAttacher {
   virtual void OnKeyframeLeaving(const Keyframe& /*kf*/) {}
   // The watchdog rebuilt the window from a fresh prior: nothing attached before is in it.
   virtual void OnWindowRebuilt() {}
+  // The watchdog's re-initialisation took fix m (or held it for the course of the next), not the attachers.
+  virtual void OnResetFix(const GnssMeasurement& /*m*/) {}
   // The attacher's entries of Smoother::Stats.
   virtual void AddStats(nlohmann::json* /*stats*/) const {}
 };
@@ -116,6 +118,7 @@ class GnssAttacher final : public MeasurementAttacher {
 
   bool OnGnss(const GnssMeasurement& m, const AttachContext& ctx) override;
   void OnWindowRebuilt() override { inflation_.Accepted(); }
+  void OnResetFix(const GnssMeasurement& /*m*/) override { ++position_counts_.used; }
   void AddStats(nlohmann::json* stats) const override;
 
  private:

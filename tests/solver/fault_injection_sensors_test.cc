@@ -2,6 +2,7 @@
 // GNSS jumps, wheels that stop, a frozen heading, a logger that pauses, and logs that end mid-initialisation.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <string>
@@ -158,8 +159,11 @@ TEST(FaultInjection, LongLoggerPauseWithoutHeading) {
   Options options = test::TestRunOptions(sim);
   options.gnss.use_heading = false;
   const double t0 = sim.start_time + 50.0, t1 = t0 + 60.0;
+  std::vector<double> fixes;  // the times of the fixes the session got
   const DriveRun run = test::RunDriveThroughSession(sim, options, Editing([&](SimRecord* r) {
-    return !(r->t() > t0 && r->t() < t1);
+    const bool kept = !(r->t() > t0 && r->t() < t1);
+    if (kept && r->type == SimRecord::Type::kGnss) fixes.push_back(r->t());
+    return kept;
   }));
   ASSERT_TRUE(run.initialized);
   test::ExpectSaneOutputs(run);
@@ -170,6 +174,10 @@ TEST(FaultInjection, LongLoggerPauseWithoutHeading) {
     ASSERT_GE(resets.size(), 1u);
     EXPECT_NEAR(resets[0]["time"].get<double>(), t1 + 1.0, 1e-6);  // the second fix after the pause
     EXPECT_EQ(resets[0]["reason"], "covariance");
+    // Every fix after the initialisation is counted, the two the reset took included.
+    const nlohmann::json& counts = run.stats["estimators"][name]["gnss_position"];
+    EXPECT_EQ(counts["offered"].get<size_t>(),
+              static_cast<size_t>(std::count_if(fixes.begin(), fixes.end(), [&](double t) { return t > run.init_t; })));
   }
 }
 

@@ -34,15 +34,17 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
     FlushCovariance();
     const double max_sigma = options_.watchdog.max_position_sigma;
     const bool finite = x_.AllFinite() && P_.allFinite() && dg_w_.allFinite() && std::isfinite(scale_);
-    if (reset_waits_for_course_ || !finite || BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
-      // A lost yaw waits for the next fix's course rather than being kept (ResetWaitsForCourse).
-      if (finite && !reset_waits_for_course_ && ResetWaitsForCourse(m, prev_fix_, options_, x_, P_)) {
+    const bool waiting = reset_waits_for_course_;
+    if (waiting || !finite || BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
+      // A lost yaw waits for a later fix's course rather than being kept (ResetWaitsForCourse).
+      if (finite && ResetWaitsForCourse(m, prev_fix_, options_, x_, P_, waiting)) {
+        if (!waiting) prev_fix_ = m;  // held: the course starts here
         reset_waits_for_course_ = true;
       } else {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
+        prev_fix_ = m;
       }
-      ++gnss_counts_.used;  // the re-initialisation's fix (or the one held for its course): offered stays every fix
-      prev_fix_ = m;
+      ++gnss_counts_.used;  // the re-initialisation's fix (or one held for its course): offered stays every fix
       return;
     }
   }

@@ -56,9 +56,11 @@ std::optional<std::pair<double, double>> CourseOf(const GnssMeasurement& m,
 }  // namespace
 
 bool ResetWaitsForCourse(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                         const EstimatorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P) {
-  return options.vehicle.nonholonomic && !RecentFix(m, prev_fix) && !HeadingUsable(m, options) &&
-         x.q_wb.coeffs().allFinite() && YawLost(x.q_wb, P);
+                         const EstimatorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P,
+                         bool waiting) {
+  if (!options.vehicle.nonholonomic || HeadingUsable(m, options) || CourseOf(m, prev_fix)) return false;
+  if (waiting) return prev_fix && m.t - prev_fix->t < kResetMaxFixInterval;
+  return x.q_wb.coeffs().allFinite() && YawLost(x.q_wb, P);
 }
 
 std::string Describe(const FixReset& r) {

@@ -143,11 +143,13 @@ struct FixReset {
 FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
                               const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P,
                               bool yaw_lost = false);
-// A reset at m would keep a lost yaw that the next fix can give (ResetPositionFromFix): the estimator
-// waits for that fix instead, a second at most on a 1 Hz receiver, and resets there with yaw_lost set.
-// P as above, at m's time.
+// A reset at m would keep a lost yaw that a later fix can give (ResetPositionFromFix): the estimator holds
+// m and waits instead, for the first fix whose course from m is within about 20° (a second on a 1 Hz RTK
+// receiver; a few fixes at 5-20 Hz with metre-level noise), at most 2 s; then it resets with yaw_lost set.
+// `waiting`: prev_fix is the fix held (the call decides whether to wait on). P as above, at m's time.
 bool ResetWaitsForCourse(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                         const EstimatorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P);
+                         const EstimatorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P,
+                         bool waiting = false);
 // The log line's words for a reset.
 std::string Describe(const FixReset& r);
 

@@ -303,15 +303,17 @@ void Smoother::AddGnss(const GnssMeasurement& m) {
     const Mat15 P = NavCovariance(window_.EstimatedTypes(), p.cov);
     const double sigma_p = std::sqrt(P.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
     const bool finite = window_.back().State().AllFinite() && pred_.AllFinite() && std::isfinite(sigma_p);
-    if (reset_waits_for_course_ || !finite || last_sigma_p_ > max_sigma || sigma_p > max_sigma) {
-      // A lost yaw waits for the next fix's course rather than being kept (ResetWaitsForCourse).
-      if (finite && !reset_waits_for_course_ && ResetWaitsForCourse(m, prev_fix_, options_, p.x, P)) {
+    const bool waiting = reset_waits_for_course_;
+    if (waiting || !finite || last_sigma_p_ > max_sigma || sigma_p > max_sigma) {
+      // A lost yaw waits for a later fix's course rather than being kept (ResetWaitsForCourse).
+      if (finite && ResetWaitsForCourse(m, prev_fix_, options_, p.x, P, waiting)) {
+        if (!waiting) prev_fix_ = m;  // held: the course starts here
         reset_waits_for_course_ = true;
       } else {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
+        prev_fix_ = m;
       }
       for (auto& attacher : attachers_) attacher->OnResetFix(m);  // counted as used: offered stays every fix
-      prev_fix_ = m;
       return;
     }
   }

@@ -104,13 +104,16 @@ TEST_F(FixResetTest, AKnownYawIsKept) {
   EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, options_, &x_, P_).yaw, "kept");
 }
 
-TEST_F(FixResetTest, WaitsForTheCourseOnlyWhenTheNextFixCanGiveTheYaw) {
+TEST_F(FixResetTest, WaitsForTheCourseOnlyWhenALaterFixCanGiveTheYaw) {
   LoseYaw(1.0);
   EXPECT_TRUE(ResetWaitsForCourse(fix_, std::nullopt, options_, x_, P_));
   prev_.t = fix_.t - 60.0;  // the fix before the pause is too old for a course
   EXPECT_TRUE(ResetWaitsForCourse(fix_, prev_, options_, x_, P_));
   prev_.t = fix_.t - 1.0;  // a recent one gives it now
   EXPECT_FALSE(ResetWaitsForCourse(fix_, prev_, options_, x_, P_));
+  GnssMeasurement slow = prev_;  // ... unless the car moved too little since for a course within ~20°
+  slow.p_w = fix_.p_w - Vec3(0.0, 0.05, 0.0);
+  EXPECT_TRUE(ResetWaitsForCourse(fix_, slow, options_, x_, P_));
   GnssMeasurement with_heading = fix_;
   with_heading.heading_valid = true;
   EXPECT_FALSE(ResetWaitsForCourse(with_heading, std::nullopt, options_, x_, P_));
@@ -121,6 +124,27 @@ TEST_F(FixResetTest, WaitsForTheCourseOnlyWhenTheNextFixCanGiveTheYaw) {
   options_.vehicle.nonholonomic = true;
   LoseYaw(10.0 * kDegToRad);
   EXPECT_FALSE(ResetWaitsForCourse(fix_, std::nullopt, options_, x_, P_));
+}
+
+// Metre-level fixes at 5 Hz: the held fix and the next are too close for a course; the wait goes on until
+// one is far enough (or 2 s have passed: then the reset keeps the yaw).
+TEST_F(FixResetTest, WaitsOnUntilAFixGivesTheCourse) {
+  LoseYaw(1.0);
+  GnssMeasurement held = fix_;
+  held.sigma_w = Vec3(1.0, 1.0, 1.5);
+  GnssMeasurement next = held;
+  for (const auto& [dt, wait] : {std::pair{0.2, true}, {0.4, true}, {0.8, false}}) {
+    next.t = held.t + dt;
+    next.p_w = held.p_w + Vec3(10.0 * dt, 0.0, 0.0);  // 10 m/s east; 3 σ of the course needs 0.42 s
+    EXPECT_EQ(ResetWaitsForCourse(next, held, options_, x_, P_, /*waiting=*/true), wait) << dt;
+  }
+  next.t = held.t + 2.0;  // stopped: no course in 2 s; the reset keeps the yaw
+  next.p_w = held.p_w;
+  EXPECT_FALSE(ResetWaitsForCourse(next, held, options_, x_, P_, /*waiting=*/true));
+  next.t = held.t + 1.9;
+  EXPECT_TRUE(ResetWaitsForCourse(next, held, options_, x_, P_, /*waiting=*/true));
+  next.heading_valid = true;  // a heading ends the wait
+  EXPECT_FALSE(ResetWaitsForCourse(next, held, options_, x_, P_, /*waiting=*/true));
 }
 
 }  // namespace

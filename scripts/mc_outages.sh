@@ -54,7 +54,8 @@ def spread(v, digits):
 with open(f"{out}/results.md", "w") as f:
     f.write(f"{n} seeds ({first}..{first + n - 1}) of config/mc_outages_sim.yaml, `gins run --mode all --config "
             "config/outages_3x60s.yaml`; median (min - max) over the seeds\n\n")
-    f.write("| estimator | H RMSE outside outages (m) | outage drift RMS (m) | outage drift max (m) |\n|---|---|---|---|\n")
+    f.write("| estimator | H RMSE outside outages (m) | outage drift RMS (m) | outage drift max (m) |\n")
+    f.write("|---|---|---|---|\n")
     for name in ("eskf", "eskf_rts", "smoother", "batch"):
         v = rows.get(name)
         if v:

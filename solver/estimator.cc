@@ -18,9 +18,6 @@ constexpr double kResetMinYawSigma = 2.0 * kDegToRad;  // a diverged estimate ma
 // Beyond this yaw 1-σ the error-state model's linearisation no longer holds (a 20° yaw error puts a third
 // of the speed across the track): such a yaw is lost, not kept.
 constexpr double kResetLostYawSigma = 20.0 * kDegToRad;
-}  // namespace
-
-namespace {
 
 bool RecentFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix) {
   return prev_fix && m.t - prev_fix->t > 0.0 && m.t - prev_fix->t <= kResetMaxFixInterval;
@@ -71,7 +68,8 @@ std::string Describe(const FixReset& r) {
 }
 
 FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                              const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P, bool yaw_lost_before) {
+                              const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P,
+                              bool yaw_lost_before) {
   FixReset result;
   // A lost yaw is replaced before the lever arm is applied: the arm turns with the body.
   const bool yaw_lost = yaw_lost_before || YawLost(x->q_wb, P);

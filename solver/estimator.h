@@ -132,14 +132,15 @@ Mat15 FallbackCovariance(const EstimatorOptions& options);
 // diverged estimate may have a wrong yaw. P is the covariance in NavState tangent order (its first 15 rows
 // and columns; more, e.g. the ESKF's gravity and scale, are left but decorrelated from δp and δv).
 // When the yaw is lost (its 1-σ beyond 20°, where the linearisation fails: a long coast, e.g. a logger
-// pause), it is not kept: it comes from the fix's dual-antenna heading, else, for a car (vehicle.nonholonomic: it drives
-// along its body x axis), from the course of the two fixes, as a moving start would take it.
+// pause), it is not kept: it comes from the fix's dual-antenna heading, else, for a car
+// (vehicle.nonholonomic: it drives along its body x axis), from the course of the two fixes, as a moving
+// start would take it.
 struct FixReset {
   bool velocity_from_fixes = false;
   const char* yaw = "kept";  // "kept" | "heading" | "course"
 };
-// `yaw_lost`: the estimator found the yaw lost at an earlier fix and waited for this one (ResetWaitsForCourse);
-// the updates in between may have shrunk its variance, not made it right.
+// `yaw_lost`: the estimator found the yaw lost at an earlier fix and waited for this one
+// (ResetWaitsForCourse); the updates in between may have shrunk its variance, not made it right.
 FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
                               const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P,
                               bool yaw_lost = false);

@@ -350,8 +350,9 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
     const std::vector<BlockType> types = window_.EstimatedTypes();
     // The older keyframes leave the window as usual (final output); the newest is replaced by the prior.
     while (window_.size() > 1) MarginalizeOldest(nullptr);
-    if (at_fix_prediction.cov.rows() == static_cast<int>(NavIndexOfTangent(types).size()) && at_fix_prediction.cov.allFinite()) {
-      cov = NavCovariance(types, at_fix_prediction.cov);
+    const MatX& predicted = at_fix_prediction.cov;
+    if (predicted.rows() == static_cast<int>(NavIndexOfTangent(types).size()) && predicted.allFinite()) {
+      cov = NavCovariance(types, predicted);
       have_cov = true;
     } else {
       have_cov = OldestCovariance(window_, &cov);

@@ -159,7 +159,8 @@ TEST_F(EvalKnownAnswers, OffsetsAndRotationsAgainstTruth) {
   EXPECT_EQ(a["outage_settle_s"].get<double>(), 5.0);
 
   // --outage-settle: 10-22.05 s and 30-37.55 s left out.
-  ASSERT_EQ(Cli({"eval", "--truth", truth_, "--summary", summary_, "--outage-settle", "2.05", "--json", out, offset_}), 0);
+  ASSERT_EQ(Cli({"eval", "--truth", truth_, "--summary", summary_, "--outage-settle", "2.05", "--json", out, offset_}),
+            0);
   EXPECT_EQ(Json(out)["trajectories"][0]["outside_outages_samples"].get<int>(), 500 - 121 - 76);
 
   const auto& b = j["trajectories"][1];

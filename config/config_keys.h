@@ -185,6 +185,7 @@ inline constexpr auto kSimulateKeys = [](auto& v, SimOptions& o) {
   v.Number("wheel_scale", o.wheel_scale, kNoUnit, Within(0.5, 1.5));
   v.Number("wheel_speed_noise_m_s", o.wheel_speed_noise, kNoUnit, NonNegative());
   v.Number("track_width_m", o.track_width, kNoUnit, Positive());
+  v.Vector3("wheel_lever_arm_m", o.wheel_lever_b, kLeverWhat, kLeverCheck);
   v.Boolean("earth_rotation", o.earth_rotation);
   v.Vector3("gnss_velocity_sigma_m_s", o.gnss_velocity_sigma, "[east, north, up]", NonNegative());
   v.Number("gnss_noise_correlation_s", o.gnss_noise_correlation, kNoUnit, NonNegative());

@@ -1,4 +1,4 @@
-# The longest seeded drives, labelled `long`. They take minutes under the sanitizers (20 Hz fixes through
+# The longest seeded drives, labelled `long`. They take minutes under the sanitizers (10-20 Hz fixes through
 # both estimators, Monte Carlo runs), so scripts/test.sh runs them in the Release pass only; the sanitizer
 # pass covers the same code through the shorter drives (5 Hz single-point, in motion, reversing, batch,
 # faults). Read twice: by tests/CMakeLists.txt for the list (the test Tests.LongLabelNamesEveryListedTest
@@ -9,7 +9,8 @@ set(GINS_LONG_TESTS
   InitializationPaths.InMotionSpp20Hz
   InitializationPaths.SlowRoverSpp
   InitializationPaths.StaticWithoutWheelsGnssVelocityWitness
-  BatchEndToEnd.SigmaAgreesWithTheMonteCarloSpread)
+  BatchEndToEnd.SigmaAgreesWithTheMonteCarloSpread
+  VehicleSetups.TenHzFixesAreAllUsed)
 if(NOT DEFINED CMAKE_PROJECT_NAME)  # in ctest
   set_tests_properties(${GINS_LONG_TESTS} PROPERTIES LABELS long)
 endif()

@@ -105,6 +105,10 @@ struct SimOptions {
   double mount_yaw = 12.06 * kDegToRad;
   double wheel_radius = 0.155, pulses_per_rev = 1024.0, wheel_scale = 0.99, wheel_speed_noise = 0.02;
   double track_width = 1.6;
+  // The rear-axle centre in the body (IMU) frame, as wheel.lever_arm_m: the segments drive that point (the
+  // wheels and the non-holonomic constraint are there), and the IMU sits at −wheel_lever_b from it, so it
+  // slides sideways in turns when the arm is along x. Zero: the IMU on the axle.
+  Vec3 wheel_lever_b = Vec3::Zero();
   // Physics and field-log set-ups (header comment).
   bool earth_rotation = true;               // the rotating Earth model; false: flat
   Vec3 gnss_velocity_sigma = Vec3::Zero();  // m/s per ENU axis; all zero: no GVEL records
@@ -156,6 +160,7 @@ class TruthTrajectory {
     void Add(double t0, double ramp, double value);  // in time order
     double Value(double s) const;
     double Rate(double s) const;
+    double RateOfRate(double s) const;  // the second derivative
     double Integral(double s) const;  // ∫ from 0 to s
     std::vector<double> Breaks() const;
 
@@ -189,6 +194,7 @@ class TruthTrajectory {
 
   double start_time_ = 0.0;
   double duration_ = 0.0;
+  Vec3 imu_from_axle_b_ = Vec3::Zero();  // −SimOptions::wheel_lever_b
   double initial_yaw_ = 0.0;
   Vec3 g_w_ = Vec3::Zero();
   LocalEnuFrame frame_;

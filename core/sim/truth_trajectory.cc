@@ -90,6 +90,13 @@ double TruthTrajectory::Profile::Rate(double s) const {
   return (p.to - p.from) * 0.5 * kPi / p.ramp * std::sin(kPi * d / p.ramp);
 }
 
+double TruthTrajectory::Profile::RateOfRate(double s) const {
+  const Piece& p = Find(s);
+  const double d = std::max(0.0, s - p.t0);
+  if (d >= p.ramp) return 0.0;
+  return (p.to - p.from) * 0.5 * (kPi / p.ramp) * (kPi / p.ramp) * std::cos(kPi * d / p.ramp);
+}
+
 double TruthTrajectory::Profile::Integral(double s) const {
   const Piece& p = Find(s);
   const double d = std::max(0.0, s - p.t0);
@@ -110,6 +117,8 @@ std::vector<double> TruthTrajectory::Profile::Breaks() const {
 TruthTrajectory::TruthTrajectory(const SimOptions& sim)
     : start_time_(sim.start_time), initial_yaw_(sim.initial_yaw), frame_(CheckedOrigin(sim.origin)) {
   Require(std::isfinite(sim.start_time) && std::isfinite(sim.initial_yaw), "start_time, initial_yaw must be finite");
+  Require(sim.wheel_lever_b.allFinite(), "wheel_lever_b must be finite");
+  imu_from_axle_b_ = -sim.wheel_lever_b;
   double t0 = 0.0;
   std::vector<std::string> names;  // of the segments in gears_, for error messages
   for (unsigned lap = 0; lap < sim.repeat; ++lap) {
@@ -268,6 +277,17 @@ TruthState TruthTrajectory::AtElapsed(double s) const {
   x.a_w = a_x * x_b_w + v_x * (yaw_rate * dx_dyaw + pitch_rate * dx_dpitch);
   x.speed = speed;
   x.reverse = reverse;
+  if (!imu_from_axle_b_.isZero()) {
+    // The path is the axle's; the IMU is the rigid point l = imu_from_axle_b_ from it:
+    // p + R·l, v + R·(ω × l), a + R·(ω̇ × l + ω × (ω × l)), with ω̇ the derivative of ω_b above.
+    const Vec3& l = imu_from_axle_b_;
+    const double yaw_acc = yaw_rate_.Rate(s), pitch_acc = grade_.RateOfRate(s);
+    const Vec3 omega_dot_b(yaw_acc * sp + yaw_rate * cp * pitch_rate, -pitch_acc,
+                           yaw_acc * cp - yaw_rate * sp * pitch_rate);
+    x.p_wb += x.q_wb * l;
+    x.v_w += x.q_wb * x.omega_b.cross(l);
+    x.a_w += x.q_wb * (omega_dot_b.cross(l) + x.omega_b.cross(x.omega_b.cross(l)));
+  }
   return x;
 }
 

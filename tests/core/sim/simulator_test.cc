@@ -125,6 +125,35 @@ TEST(SimTruth, DerivativesConsistent) {
   EXPECT_GT(checked, 130);
 }
 
+// With the rear axle 1.5 m behind the IMU (simulate.wheel_lever_arm_m): the segments drive the axle, which
+// does not slip; the IMU, a rigid point ahead of it, slides sideways in turns by ω·1.5 m, and its p, v, a_w
+// stay consistent by central differences.
+TEST(SimTruth, AxleLeverPutsTheImuAheadOfTheNonSlippingAxle) {
+  SimOptions sim = Drive();
+  sim.wheel_lever_b = Vec3(-1.5, 0.2, -0.3);
+  const TruthTrajectory truth(sim), on_axle(Drive());
+  const double h = 1e-4;
+  int checked = 0, sliding = 0;
+  for (double s = 0.013; s < truth.duration() - h; s += 0.37) {
+    const TruthState m = truth.AtElapsed(s - h), x = truth.AtElapsed(s), p = truth.AtElapsed(s + h);
+    if (m.speed == 0.0 || p.speed == 0.0) continue;
+    EXPECT_LT(((p.p_wb - m.p_wb) / (2 * h) - x.v_w).norm(), 1e-7) << s;
+    EXPECT_LT(((p.v_w - m.v_w) / (2 * h) - x.a_w).norm(), 1e-5) << s;
+    // The axle point: the path of the drive without the arm, and no side slip there.
+    const TruthState a = on_axle.AtElapsed(s);
+    EXPECT_LT((x.p_wb + x.q_wb * sim.wheel_lever_b - a.p_wb).norm(), 1e-9) << s;
+    const Vec3 v_axle_b = x.q_wb.conjugate() * x.v_w + x.omega_b.cross(sim.wheel_lever_b);
+    EXPECT_LT(v_axle_b.tail<2>().norm(), 1e-9) << s;
+    // The IMU's own sideways speed: ω_z times the 1.5 m (and the small y arm's share).
+    const Vec3 v_imu_b = x.q_wb.conjugate() * x.v_w;
+    EXPECT_NEAR(v_imu_b.y(), x.omega_b.z() * 1.5 - x.omega_b.x() * 0.3, 1e-9) << s;
+    sliding += std::abs(v_imu_b.y()) > 0.1;
+    ++checked;
+  }
+  EXPECT_GT(checked, 130);
+  EXPECT_GT(sliding, 30);  // the turns
+}
+
 // Random segments (short ones, sign changes, repeated stops and starts): the speed stays ≥ 0 and
 // continuous, and p, v, q stay consistent with v, a_w, ω_b away from the stop kinks.
 TEST(SimTruth, RandomSegmentsStayConsistent) {

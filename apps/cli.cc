@@ -45,14 +45,14 @@ void PrintComparison(const nlohmann::json& s) {
         std::printf("    %-15s %s\n", name.c_str(), m["error"].get<std::string>().c_str());
         continue;
       }
+      const std::string drift_max = JsonNum(m["outage_drift_max_m"], "%.3f");
       std::printf("    %-15s %8s %8s %9s %13s %13s %11s / %s", name.c_str(),
                   JsonNum(m["rmse_horizontal_m"], "%.3f").c_str(), JsonNum(m["max_horizontal_m"], "%.3f").c_str(),
                   JsonNum(m["rmse_vertical_m"], "%.3f").c_str(), JsonNum(m["rmse_velocity_m_s"], "%.3f").c_str(),
                   JsonNum(m["rmse_heading_deg"], "%.3f").c_str(), JsonNum(m["outage_drift_rms_m"], "%.3f").c_str(),
-                  JsonNum(m["outage_drift_max_m"], "%.3f").c_str());
+                  drift_max.c_str());
       // The accuracy with GNSS (outside outages and their settle time), apart from the drift.
       if (m.contains("rmse_horizontal_outside_outages_m")) {
-        const std::string drift_max = JsonNum(m["outage_drift_max_m"], "%.3f");
         std::printf("%*s %16s", static_cast<int>(9 - std::min<size_t>(9, drift_max.size())), "",
                     JsonNum(m["rmse_horizontal_outside_outages_m"], "%.4f").c_str());
       }

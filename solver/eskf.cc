@@ -355,8 +355,7 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
     }
     if (options_.wheel.enabled && options_.wheel.estimate_scale) P_(eskf::kS, eskf::kS) = std::pow(options_.wheel.scale_sigma, 2);
   }
-  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &x_, P_, reset_waits_for_course_);
-  reset_waits_for_course_ = false;
+  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &x_, P_, course_wait_.Take());
   P_ = 0.5 * (P_ + P_.transpose());
   gyro_sum_.setZero();
   gyro_count_ = 0;

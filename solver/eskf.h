@@ -171,7 +171,7 @@ class Eskf : public Estimator {
 
   GnssWatchdog watchdog_;
   std::optional<GnssMeasurement> prev_fix_;  // the fix before the current one, accepted or not
-  bool reset_waits_for_course_ = false;       // a re-initialisation waits for a later fix (ResetWaitsForCourse)
+  CourseWait course_wait_;                    // a re-initialisation waiting for a later fix's course
 };
 
 }  // namespace gins

@@ -34,13 +34,10 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
     FlushCovariance();
     const double max_sigma = options_.watchdog.max_position_sigma;
     const bool finite = x_.AllFinite() && P_.allFinite() && dg_w_.allFinite() && std::isfinite(scale_);
-    const bool waiting = reset_waits_for_course_;
-    if (waiting || !finite || BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
+    if (course_wait_.waiting() || !finite ||
+        BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
       // A lost yaw waits for a later fix's course rather than being kept (ResetWaitsForCourse).
-      if (finite && ResetWaitsForCourse(m, prev_fix_, options_, x_, P_, waiting)) {
-        if (!waiting) prev_fix_ = m;  // held: the course starts here
-        reset_waits_for_course_ = true;
-      } else {
+      if (!(finite && course_wait_.Hold(m, &prev_fix_, options_, x_, P_))) {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
         prev_fix_ = m;
       }

@@ -60,6 +60,14 @@ bool ResetWaitsForCourse(const GnssMeasurement& m, const std::optional<GnssMeasu
   return x.q_wb.coeffs().allFinite() && YawLost(x.q_wb, P);
 }
 
+bool CourseWait::Hold(const GnssMeasurement& m, std::optional<GnssMeasurement>* prev_fix,
+                      const EstimatorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P) {
+  if (!ResetWaitsForCourse(m, *prev_fix, options, x, P, waiting_)) return false;
+  if (!waiting_) *prev_fix = m;
+  waiting_ = true;
+  return true;
+}
+
 std::string Describe(const FixReset& r) {
   std::string s = r.velocity_from_fixes ? "velocity from the last two fixes" : "velocity kept";
   if (std::string(r.yaw) == "heading") s += ", yaw from the dual-antenna heading";

@@ -154,6 +154,24 @@ bool ResetWaitsForCourse(const GnssMeasurement& m, const std::optional<GnssMeasu
 // The log line's words for a reset.
 std::string Describe(const FixReset& r);
 
+// The wait of ResetWaitsForCourse, alike in both estimators. Hold: whether the reset due at fix m waits
+// (the first fix held in *prev_fix: the course starts there). Take, at the reset: whether it waited (the yaw
+// was lost), ending the wait.
+class CourseWait {
+ public:
+  bool waiting() const { return waiting_; }
+  bool Hold(const GnssMeasurement& m, std::optional<GnssMeasurement>* prev_fix, const EstimatorOptions& options,
+            const NavState& x, const Eigen::Ref<const MatX>& P);
+  bool Take() {
+    const bool waited = waiting_;
+    waiting_ = false;
+    return waited;
+  }
+
+ private:
+  bool waiting_ = false;
+};
+
 class Estimator {
  public:
   virtual ~Estimator() = default;

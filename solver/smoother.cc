@@ -303,13 +303,9 @@ void Smoother::AddGnss(const GnssMeasurement& m) {
     const Mat15 P = NavCovariance(window_.EstimatedTypes(), p.cov);
     const double sigma_p = std::sqrt(P.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
     const bool finite = window_.back().State().AllFinite() && pred_.AllFinite() && std::isfinite(sigma_p);
-    const bool waiting = reset_waits_for_course_;
-    if (waiting || !finite || last_sigma_p_ > max_sigma || sigma_p > max_sigma) {
+    if (course_wait_.waiting() || !finite || last_sigma_p_ > max_sigma || sigma_p > max_sigma) {
       // A lost yaw waits for a later fix's course rather than being kept (ResetWaitsForCourse).
-      if (finite && ResetWaitsForCourse(m, prev_fix_, options_, p.x, P, waiting)) {
-        if (!waiting) prev_fix_ = m;  // held: the course starts here
-        reset_waits_for_course_ = true;
-      } else {
+      if (!(finite && course_wait_.Hold(m, &prev_fix_, options_, p.x, P))) {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
         prev_fix_ = m;
       }
@@ -366,8 +362,7 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
   if (!have_cov) cov = FallbackCovariance(options_);
   init.g_norm = earth_.g_norm();
   init.earth = earth_;
-  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &init.x0, cov, reset_waits_for_course_);
-  reset_waits_for_course_ = false;
+  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &init.x0, cov, course_wait_.Take());
   // Tiny floors keep the prior invertible whatever the window's covariance was.
   cov = 0.5 * (cov + cov.transpose());
   cov.diagonal() = cov.diagonal().cwiseMax(1e-12);

@@ -126,7 +126,7 @@ class Smoother : public Estimator {
   GnssWatchdog watchdog_;
   std::string reset_reason_;      // set by the checks, acted on at the end of AddGnss
   std::optional<GnssMeasurement> prev_fix_;
-  bool reset_waits_for_course_ = false;  // a rebuild waits for a later fix (ResetWaitsForCourse)
+  CourseWait course_wait_;        // a rebuild waiting for a later fix's course
   double last_sigma_p_ = 0.0;     // largest position 1-σ of the last keyframe marginalised
   ImuGapLog imu_gaps_;
 

@@ -84,18 +84,26 @@ struct DriveErrors {
   double rmse_h = 0.0, max_h = 0.0, rmse_v = 0.0, rmse_vel = 0.0, rmse_yaw_deg = 0.0, max_yaw_deg = 0.0;
 };
 
-// Errors of the states with t in [from, to) against the truth at the same IMU time (states at other times,
-// e.g. keyframes between IMU samples, are skipped).
-inline DriveErrors Errors(const DriveRun& run, const std::vector<StateEstimate>& states, double from,
-                          double to = 1e300) {
-  DriveErrors e;
+// Calls f(state, j) for each state with t in [from, to) and run.truth[j] the truth at the same IMU time
+// (states at other times, e.g. keyframes between IMU samples, are skipped). States in time order.
+template <typename F>
+void ForEachAtTruth(const DriveRun& run, const std::vector<StateEstimate>& states, double from, double to, F f) {
   size_t j = 0;
-  double h2 = 0.0, v2 = 0.0, vel2 = 0.0, yaw2 = 0.0;
   for (const StateEstimate& s : states) {
     const double t = s.x.t;
     if (t < from || t >= to) continue;
     while (j < run.truth_t.size() && run.truth_t[j] < t - 1e-7) ++j;
     if (j == run.truth_t.size() || std::abs(run.truth_t[j] - t) > 1e-7) continue;
+    f(s, j);
+  }
+}
+
+// Errors of the states with t in [from, to) against the truth at the same IMU time.
+inline DriveErrors Errors(const DriveRun& run, const std::vector<StateEstimate>& states, double from,
+                          double to = 1e300) {
+  DriveErrors e;
+  double h2 = 0.0, v2 = 0.0, vel2 = 0.0, yaw2 = 0.0;
+  ForEachAtTruth(run, states, from, to, [&](const StateEstimate& s, size_t j) {
     const NavState& x = run.truth[j];
     const Vec3 d = s.x.p_wb - x.p_wb;
     const double yaw = WrapAngle(YawOfXAxis<double>(s.x.R_wb()) - YawOfXAxis<double>(x.R_wb())) * kRadToDeg;
@@ -106,7 +114,7 @@ inline DriveErrors Errors(const DriveRun& run, const std::vector<StateEstimate>&
     e.max_h = std::max(e.max_h, d.head<2>().norm());
     e.max_yaw_deg = std::max(e.max_yaw_deg, std::abs(yaw));
     ++e.n;
-  }
+  });
   if (e.n > 0) {
     const double n = static_cast<double>(e.n);
     e.rmse_h = std::sqrt(h2 / n);

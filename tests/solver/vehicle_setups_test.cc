@@ -24,22 +24,19 @@ struct TurnYaw {
 };
 TurnYaw YawInTurns(const DriveRun& run, const std::vector<StateEstimate>& states, double from) {
   TurnYaw r;
-  size_t j = 0;
   double sum = 0.0;
-  for (const StateEstimate& s : states) {
-    if (s.x.t < from) continue;
-    while (j < run.truth_t.size() && run.truth_t[j] < s.x.t - 1e-7) ++j;
-    if (j == run.truth_t.size() || std::abs(run.truth_t[j] - s.x.t) > 1e-7 || j == 0) continue;
+  test::ForEachAtTruth(run, states, from, 1e300, [&](const StateEstimate& s, size_t j) {
+    if (j == 0) return;
     const double yaw_rate = WrapAngle(YawOfXAxis<double>(run.truth[j].R_wb()) -
                                       YawOfXAxis<double>(run.truth[j - 1].R_wb())) /
                             (run.truth_t[j] - run.truth_t[j - 1]);
-    if (std::abs(yaw_rate) < 3.0 * kDegToRad) continue;
+    if (std::abs(yaw_rate) < 3.0 * kDegToRad) return;
     const double e = WrapAngle(YawOfXAxis<double>(s.x.R_wb()) - YawOfXAxis<double>(run.truth[j].R_wb())) * kRadToDeg;
     // Signed by the turn's direction: a constraint at the wrong point biases the yaw into or out of every turn.
     sum += yaw_rate > 0.0 ? e : -e;
     r.max_deg = std::max(r.max_deg, std::abs(e));
     ++r.n;
-  }
+  });
   if (r.n > 0) r.mean_deg = sum / static_cast<double>(r.n);
   return r;
 }

@@ -117,7 +117,6 @@ inline constexpr auto kSmootherKeys = [](auto& v, SmootherOptions& o) {
   v.Integer("max_iterations", o.max_iterations, 1);
   v.Number("function_tolerance", o.function_tolerance, kNoUnit, Within(1e-12, 0.1));
   v.Integer("num_threads", o.num_threads, 1);
-  v.Number("gnss_loss_scale", o.gnss_loss_scale, kNoUnit, Positive());
   v.Number("bias_reintegrate_threshold", o.bias_reintegrate_threshold, kNoUnit, NonNegative());
 };
 

@@ -96,4 +96,20 @@ std::vector<NamedAxes> KnownAxes();
 std::string Text(double v, int precision = 6);
 bool ParseDouble(const std::string& s, double* v);
 
+// ---------------------------------------------------------------------------------------------------------
+// Keys that gins once read and no longer does. A config that sets one fails like an unknown key, but with
+// why it went and what replaces it: a key accepted and ignored would let a user tune a setting that does
+// nothing.
+
+struct RemovedKey {
+  const char* path;
+  const char* reason;
+};
+
+inline constexpr RemovedKey kRemovedKeys[] = {
+    {"smoother.gnss_loss_scale",
+     "removed key: the smoother's GNSS factors carry a Huber loss whose corner is the gate "
+     "(gnss.gate_probability), so every fix the gate accepts keeps full weight; delete the line"},
+};
+
 }  // namespace gins::config_internal

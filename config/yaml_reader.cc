@@ -148,6 +148,9 @@ const YAML::Node* YamlReader::Find(const std::string& key) {
 void YamlReader::Finish() const {
   for (const auto& [key, mark] : order_) {
     if (std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
+    for (const RemovedKey& removed : kRemovedKeys) {
+      if (Path(key) == removed.path) ctx_.Fail(Path(key), removed.reason, mark);
+    }
     std::string reason = "unknown key";
     const std::string guess = ClosestKey(key, known_);
     if (!guess.empty()) reason += " (did you mean " + Path(guess) + "?)";

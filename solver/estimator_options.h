@@ -26,7 +26,6 @@ struct SmootherOptions {
   int max_iterations = 10;          // smoother.max_iterations
   double function_tolerance = 1e-6;  // smoother.function_tolerance: stop when |Δcost|/cost falls below
   int num_threads = 1;              // smoother.num_threads
-  double gnss_loss_scale = 3.0;     // smoother.gnss_loss_scale: Cauchy loss scale on whitened residuals
   double bias_reintegrate_threshold = 1e-3;  // smoother.bias_reintegrate_threshold (norm of δbg, rad/s)
 };
 

@@ -117,7 +117,6 @@ Comparison Compare(const Options& a, const Options& b) {
   GINS_FIELD(smoother.linear_solver);
   GINS_FIELD(smoother.max_iterations);
   GINS_FIELD(smoother.num_threads);
-  GINS_FIELD(smoother.gnss_loss_scale);
   GINS_FIELD(smoother.bias_reintegrate_threshold);
   GINS_FIELD(standstill.enabled);
   GINS_FIELD(standstill.window);
@@ -227,7 +226,6 @@ Options NonDefaultOptions() {
   o.smoother.linear_solver = "dense_schur";
   o.smoother.max_iterations = 4;
   o.smoother.num_threads = 4;
-  o.smoother.gnss_loss_scale = 1.5;
   o.smoother.bias_reintegrate_threshold = 0.0;
   o.standstill.enabled = false;
   o.standstill.window = 2.0;
@@ -506,6 +504,14 @@ TEST(ConfigLoaderTest, UnknownKeysNameTheFullPathAndSuggest) {
   });
   // No suggestion when nothing is close.
   EXPECT_EQ(ErrorOf("eskf: {zzzzzzzzzz: 1}").find("did you mean"), std::string::npos);
+}
+
+TEST(ConfigLoaderTest, RemovedKeysSayWhyAndWhatReplacesThem) {
+  ExpectErrors({{"smoother:\n  window_size: 5\n  gnss_loss_scale: 3.0\n",
+                 {"test.yaml: smoother.gnss_loss_scale: removed key", "gnss.gate_probability", "(line 3)"}}});
+  // Only at its own path: the same name elsewhere is an ordinary unknown key.
+  ExpectErrors({{"batch: {gnss_loss_scale: 3.0}", {"batch.gnss_loss_scale: unknown key"}}});
+  EXPECT_EQ(ErrorOf("batch: {gnss_loss_scale: 3.0}").find("removed"), std::string::npos);
 }
 
 TEST(ConfigLoaderTest, WrongTypesNameTheKeyAndWhatWasExpected) {

@@ -17,4 +17,12 @@ struct Options : EstimatorOptions {
   SimOptions simulate;  // simulate.* (only `gins simulate` reads it)
 };
 
+// What a log reader takes from a config: input.*, and the IMU's range from imu.* (a reading beyond it is
+// damage).
+inline InputOptions ReaderOptions(const Options& o) {
+  InputOptions in = o.input;
+  in.imu_range = {o.imu.max_gyro, o.imu.max_acc};
+  return in;
+}
+
 }  // namespace gins

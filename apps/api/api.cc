@@ -140,14 +140,14 @@ auto InputErrors(F&& f) -> decltype(f()) {
 
 LogReader::LogReader(const std::string& path, const Config& config)
     : impl_(InputErrors([&] {
-        return std::make_unique<Impl>(std::make_unique<::gins::LogReader>(path, config.impl_->options.input));
+        return std::make_unique<Impl>(std::make_unique<::gins::LogReader>(path, ReaderOptions(config.impl_->options)));
       })) {}
 
 LogReader::LogReader(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 LogReader LogReader::FromFd(int fd, const std::string& name, const Config& config, int stop_fd) {
-  return LogReader(
-      std::make_unique<Impl>(std::make_unique<::gins::LogReader>(fd, name, config.impl_->options.input, stop_fd)));
+  return LogReader(std::make_unique<Impl>(
+      std::make_unique<::gins::LogReader>(fd, name, ReaderOptions(config.impl_->options), stop_fd)));
 }
 
 LogReader::~LogReader() = default;

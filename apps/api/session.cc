@@ -47,6 +47,7 @@ class Session::Impl {
   const SessionOptions session_options_;
   ::gins::Session session_;
   ReorderBuffer reorder_;
+  const ImuRange imu_range_;  // a pushed IMU record beyond it is damage, as in a log
   StateCallback callback_;
   std::deque<State> queue_;
   std::exception_ptr callback_error_;  // the first exception of the current call, rethrown at its end
@@ -63,7 +64,8 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
     : options_(options),
       session_options_(session_options),
       session_(options_),
-      reorder_(options_.input.reorder_window) {
+      reorder_(options_.input.reorder_window),
+      imu_range_(ReaderOptions(options_).imu_range) {
   session_.SetParallel(session_options_.parallel);
   const Mode mode = session_options_.mode;
   const bool all = mode == Mode::kAll;
@@ -87,7 +89,7 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
 
 bool Session::Impl::Push(LogRecord record) {
   if (finished_) throw Error(Error::Kind::kUsage, "gins::api::Session: Push after Finish");
-  if (CheckLogRecord(&record, &issue_) == LineParse::kDamaged) return Reject(record.type, issue_.reason);
+  if (CheckLogRecord(&record, &issue_, imu_range_) == LineParse::kDamaged) return Reject(record.type, issue_.reason);
   if (!reorder_.Add(record, [this](const LogRecord& r) { Dispatch(r); })) return Reject(record.type, "late");
   ++accepted_;
   RethrowCallbackError();

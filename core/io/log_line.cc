@@ -20,8 +20,6 @@ using input_reason::kExtraFields;
 using input_reason::kMissingFields;
 using input_reason::kNonFinite;
 using input_reason::kUnknownType;
-using log_limits::kMaxAbsAcc;
-using log_limits::kMaxAbsGyro;
 using log_limits::kMaxAbsHeadingDeg;
 using log_limits::kMaxAbsLatDeg;
 using log_limits::kMaxAbsLonDeg;
@@ -82,15 +80,15 @@ std::string Num(double value) {
 }
 
 // Range checks on parsed numbers; returns the detail of the first absurd field, or empty.
-std::string CheckImu(const double* v) {
+std::string CheckImu(const double* v, const ImuRange& range) {
   for (size_t i = 1; i <= 3; ++i) {
-    if (std::abs(v[i]) > kMaxAbsGyro) {
-      return FieldValue(i, kImuFields[i], v[i]) + " rad/s, beyond ±" + Num(kMaxAbsGyro);
+    if (std::abs(v[i]) > range.max_gyro) {
+      return FieldValue(i, kImuFields[i], v[i]) + " rad/s, beyond ±" + Num(range.max_gyro) + " (imu.max_gyro_rad_s)";
     }
   }
   for (size_t i = 4; i <= 6; ++i) {
-    if (std::abs(v[i]) > kMaxAbsAcc) {
-      return FieldValue(i, kImuFields[i], v[i]) + " m/s², beyond ±" + Num(kMaxAbsAcc);
+    if (std::abs(v[i]) > range.max_acc) {
+      return FieldValue(i, kImuFields[i], v[i]) + " m/s², beyond ±" + Num(range.max_acc) + " (imu.max_acc_m_s2)";
     }
   }
   return {};
@@ -202,7 +200,7 @@ LineParse CheckFieldCount(LogRecord::Type type, const char* const* names, size_t
 
 // Range checks of a record's n finite numbers v (in log field order): one rule for parsed lines and for
 // records pushed through the API.
-LineParse CheckValues(LogRecord::Type type, size_t n, const double* v, InputIssue* issue) {
+LineParse CheckValues(LogRecord::Type type, size_t n, const double* v, const ImuRange& range, InputIssue* issue) {
   if (!(v[0] > 0.0)) return Damaged(issue, kAbsurdValue, FieldValue(0, "t", v[0]) + ", time must be > 0");
   if (!(v[0] < log_limits::kMaxTime)) {
     return Damaged(issue, kAbsurdValue,
@@ -211,7 +209,7 @@ LineParse CheckValues(LogRecord::Type type, size_t n, const double* v, InputIssu
   std::string absurd;
   switch (type) {
     case LogRecord::Type::kImu:
-      absurd = CheckImu(v);
+      absurd = CheckImu(v, range);
       break;
     case LogRecord::Type::kOdom:
       absurd = CheckOdom(v);
@@ -229,7 +227,7 @@ LineParse CheckValues(LogRecord::Type type, size_t n, const double* v, InputIssu
 
 // Parses the n numbers after the type into v, then checks their ranges.
 LineParse ParseValues(const Tokens& tokens, LogRecord::Type type, const char* const* names, size_t n, double* v,
-                      InputIssue* issue) {
+                      const ImuRange& range, InputIssue* issue) {
   for (size_t i = 0; i < n; ++i) {
     const NumberStatus status = ParseNumber(tokens.tok[i + 1], &v[i]);
     if (status == NumberStatus::kOk) continue;
@@ -238,7 +236,7 @@ LineParse ParseValues(const Tokens& tokens, LogRecord::Type type, const char* co
     if (status == NumberStatus::kBad) return Damaged(issue, kBadNumber, field + " is not a number");
     return Damaged(issue, kNonFinite, field + " is not finite");
   }
-  return CheckValues(type, n, v, issue);
+  return CheckValues(type, n, v, range, issue);
 }
 
 void FillRecord(const double* v, size_t n, LogRecord* record) {
@@ -312,7 +310,7 @@ size_t RecordValues(const LogRecord& record, double* v, const char* const** name
 
 }  // namespace
 
-LineParse CheckLogRecord(LogRecord* record, InputIssue* issue) {
+LineParse CheckLogRecord(LogRecord* record, InputIssue* issue, const ImuRange& range) {
   double v[kMaxNumbers];
   const char* const* names = nullptr;
   const size_t n = RecordValues(*record, v, &names);
@@ -321,7 +319,7 @@ LineParse CheckLogRecord(LogRecord* record, InputIssue* issue) {
       return Damaged(issue, kNonFinite, "field " + std::to_string(i + 2) + " (" + names[i] + ") is not finite");
     }
   }
-  if (CheckValues(record->type, n, v, issue) == LineParse::kDamaged) return LineParse::kDamaged;
+  if (CheckValues(record->type, n, v, range, issue) == LineParse::kDamaged) return LineParse::kDamaged;
   FillRecord(v, n, record);  // as a parsed line: the heading normalised, unused fields zero
   return LineParse::kRecord;
 }
@@ -354,7 +352,7 @@ const char* LogRecordTypeName(LogRecord::Type type) {
   return "?";
 }
 
-LineParse ParseLogLine(std::string_view line, LogRecord* record, InputIssue* issue) {
+LineParse ParseLogLine(std::string_view line, LogRecord* record, InputIssue* issue, const ImuRange& range) {
   if (const void* hash = std::memchr(line.data(), '#', line.size())) {
     line = line.substr(0, static_cast<const char*>(hash) - line.data());
   }
@@ -373,7 +371,7 @@ LineParse ParseLogLine(std::string_view line, LogRecord* record, InputIssue* iss
     return LineParse::kDamaged;
   }
   double v[kMaxNumbers];
-  if (ParseValues(tokens, record->type, names, n, v, issue) == LineParse::kDamaged) return LineParse::kDamaged;
+  if (ParseValues(tokens, record->type, names, n, v, range, issue) == LineParse::kDamaged) return LineParse::kDamaged;
   FillRecord(v, n, record);
   return LineParse::kRecord;
 }

@@ -188,7 +188,7 @@ bool LogReader::Impl::Next(LogRecord* record) {
     ++stats_->lines;
     if (DamagedByReading(line)) continue;
 
-    const LineParse parsed = ParseLogLine(line.text, record, &issue_);
+    const LineParse parsed = ParseLogLine(line.text, record, &issue_, options_.imu_range);
     if (parsed == LineParse::kBlank) continue;
     const char* reason = nullptr;
     std::string detail;

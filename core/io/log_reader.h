@@ -33,20 +33,10 @@ namespace gins {
 
 enum class InputErrorPolicy { kSkip, kStop };
 
-// input.*
-struct InputOptions {
-  InputErrorPolicy on_error = InputErrorPolicy::kSkip;  // input.on_error: skip | stop
-  int max_errors = 1000;             // input.max_errors: give up after this many skipped lines (skip policy)
-  int max_line_length = 4096;        // input.max_line_length: characters; longer lines are damage
-  double max_time_jump = 60.0;       // input.max_time_jump_s: a record this far ahead of the newest time is
-                                     // damage (time_jump); 0 = no limit
-  double reorder_window = 0.0;       // input.reorder_window_s: a record this much older than the newest is
-                                     // sorted into place; older ones are out_of_order
-};
-
-// Plausibility limits of a log record (ParseLogLine). The reader sees only InputOptions, so they are fixed;
-// gyro and acc match the ImuOptions defaults (max_gyro, max_acc). Anything beyond them is a corrupted field,
-// not a measurement. Writers of logs (core/io/i2nav.h) check against the same limits.
+// Plausibility limits of a log record (ParseLogLine). Anything beyond them is a corrupted field, not a
+// measurement. Gyro and acc are the defaults of the IMU's range (ImuRange below: imu.max_gyro_rad_s,
+// imu.max_acc_m_s2), which a config may change; the rest are fixed. Writers of logs (core/io/i2nav.h) check
+// against these defaults.
 namespace log_limits {
 inline constexpr double kMaxAbsGyro = 35.0;         // rad/s, per axis
 inline constexpr double kMaxAbsAcc = 200.0;         // m/s², per axis
@@ -63,6 +53,27 @@ inline constexpr double kMaxAbsSpeed = 1000.0;      // m/s, per axis of a GNSS v
 // between two records, and the fourth power of it that a coasted covariance takes, finite.
 inline constexpr double kMaxTime = 1e10;            // s, exclusive
 }  // namespace log_limits
+
+// The IMU's measurement range, per axis: a reading beyond it is damage (absurd_value), not motion. The keys
+// are the sensor's (imu.max_gyro_rad_s, imu.max_acc_m_s2: ImuOptions::max_gyro, max_acc); whoever opens a log
+// with a config copies them in (ReaderOptions, config/options.h).
+struct ImuRange {
+  double max_gyro = log_limits::kMaxAbsGyro;  // rad/s
+  double max_acc = log_limits::kMaxAbsAcc;    // m/s²
+};
+
+// input.*
+struct InputOptions {
+  InputErrorPolicy on_error = InputErrorPolicy::kSkip;  // input.on_error: skip | stop
+  int max_errors = 1000;             // input.max_errors: give up after this many skipped lines (skip policy)
+  int max_line_length = 4096;        // input.max_line_length: characters; longer lines are damage
+  double max_time_jump = 60.0;       // input.max_time_jump_s: a record this far ahead of the newest time is
+                                     // damage (time_jump); 0 = no limit
+  double reorder_window = 0.0;       // input.reorder_window_s: a record this much older than the newest is
+                                     // sorted into place; older ones are out_of_order
+  ImuRange imu_range;                // not an input.* key: the imu.* range (ReaderOptions)
+};
+
 
 struct LogRecord {
   enum class Type { kImu, kOdom, kGnss, kGvel };
@@ -103,12 +114,12 @@ struct ReadStats {
 // kDamaged with issue->reason and issue->detail filled. Allocates only for a damaged line. Exposed for
 // tests and the fuzzer.
 enum class LineParse { kRecord, kBlank, kDamaged };
-LineParse ParseLogLine(std::string_view line, LogRecord* record, InputIssue* issue);
+LineParse ParseLogLine(std::string_view line, LogRecord* record, InputIssue* issue, const ImuRange& range = {});
 
 // The same checks on a record that did not come from a line (the API's pushes): every number finite, then
 // ParseLogLine's range checks; on success the record is made what ParseLogLine would have made of it (a
 // valid heading normalised into [0, 360), an invalid one 0). Returns kRecord or kDamaged with *issue filled.
-LineParse CheckLogRecord(LogRecord* record, InputIssue* issue);
+LineParse CheckLogRecord(LogRecord* record, InputIssue* issue, const ImuRange& range = {});
 
 class LogReader {
  public:

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -233,6 +234,51 @@ TEST(ApiSessionTest, InvalidMeasurementsAreRefusedWithTheLogReadersReasons) {
   EXPECT_FALSE(status.initialized);
   EXPECT_FALSE(status.origin.has_value());
   EXPECT_NE(status.diagnosis.find("no GNSS fix"), std::string::npos) << status.diagnosis;
+}
+
+// imu.max_gyro_rad_s and imu.max_acc_m_s2 are the sensor's range: a reading beyond it is refused as in a log,
+// pushed or read, and a wider range lets through what the defaults refuse.
+TEST(ApiSessionTest, ImuRangeComesFromTheConfig) {
+  const Config narrow = Config::FromYaml("imu: {max_gyro_rad_s: 10, max_acc_m_s2: 100}");
+  const Config wide = Config::FromYaml("imu: {max_gyro_rad_s: 50, max_acc_m_s2: 300}");
+  Imu imu;
+  imu.t = 1.0;
+  imu.acc[0] = 150.0;
+  imu.acc[2] = 9.8;
+  Session defaults(Config(), Mode::kEskf);
+  Session n(narrow, Mode::kEskf);
+  Session w(wide, Mode::kEskf);
+  EXPECT_TRUE(defaults.Push(imu));
+  EXPECT_FALSE(n.Push(imu));
+  EXPECT_TRUE(w.Push(imu));
+  imu.t = 1.01;
+  imu.acc[0] = 250.0;
+  EXPECT_FALSE(defaults.Push(imu));
+  EXPECT_TRUE(w.Push(imu));
+  imu.t = 1.02;
+  imu.acc[0] = 0.0;
+  imu.gyro[2] = 20.0;
+  EXPECT_FALSE(n.Push(imu));
+  ASSERT_EQ(n.status().rejections.size(), 1u);
+  EXPECT_EQ(n.status().rejections[0].measurement + "/" + n.status().rejections[0].reason, "imu/absurd_value");
+  EXPECT_EQ(n.status().rejections[0].count, 2u);
+  EXPECT_EQ(n.status().rejected, 2u);
+
+  const std::string path = ::testing::TempDir() + "/gins_imu_range_log.txt";
+  {
+    std::ofstream out(path);
+    out << "IMU 1.0 0 0 0 0 0 9.8\nIMU 1.01 0 0 0 150 0 9.8\nIMU 1.02 0 0 0 250 0 9.8\n";
+  }
+  const auto count = [&](const Config& config) {
+    LogReader reader(path, config);
+    Record r;
+    size_t records = 0;
+    while (reader.Next(&r)) ++records;
+    return records;
+  };
+  EXPECT_EQ(count(Config()), 2u);
+  EXPECT_EQ(count(narrow), 1u);
+  EXPECT_EQ(count(wide), 3u);
 }
 
 TEST(ApiSessionTest, StatusNamesTheEstimatorsRejections) {

@@ -669,6 +669,52 @@ TEST(LogReaderCheckLogRecordTest, SameRulesAsALine) {
   EXPECT_EQ(issue.reason, "absurd_value");
 }
 
+// The IMU's range (imu.max_gyro_rad_s, imu.max_acc_m_s2) is the config's, not fixed: a narrower one makes a
+// reading inside the defaults damage, a wider one lets a reading beyond them through; lines and pushed
+// records alike. The detail names the key.
+TEST_F(LogReaderTest, ImuRangeFromTheOptions) {
+  const std::string path = Write("range.txt",
+                                 "IMU 1.0 0 0 0 0 0 9.8\n"
+                                 "IMU 1.1 0 0 0 150 0 9.8\n"  // beyond a ±100 m/s² sensor
+                                 "IMU 1.2 0 0 20 0 0 9.8\n"   // beyond a ±10 rad/s sensor
+                                 "IMU 1.3 0 0 0 250 0 9.8\n"  // beyond the default ±200 m/s²
+                                 "IMU 1.4 0 40 0 0 0 9.8\n");  // beyond the default ±35 rad/s
+  const ReadResult defaults = ReadAll(path);
+  EXPECT_EQ(defaults.records.size(), 3u);
+  EXPECT_EQ(defaults.stats.skipped.at("absurd_value"), 2u);
+
+  InputOptions narrow;
+  narrow.imu_range = {10.0, 100.0};
+  const ReadResult n = ReadAll(path, narrow);
+  ASSERT_EQ(n.records.size(), 1u);
+  EXPECT_EQ(n.records[0].t(), 1.0);
+  EXPECT_EQ(n.stats.skipped.at("absurd_value"), 4u);
+
+  InputOptions wide;
+  wide.imu_range = {50.0, 300.0};
+  const ReadResult w = ReadAll(path, wide);
+  ASSERT_EQ(w.records.size(), 5u);
+  EXPECT_EQ(w.records[3].imu.acc.x(), 250.0);
+  EXPECT_EQ(w.records[4].imu.gyro.y(), 40.0);
+  EXPECT_EQ(w.stats.total_skipped(), 0u);
+
+  LogRecord record;
+  InputIssue issue;
+  ASSERT_EQ(ParseLogLine("IMU 1.1 0 0 0 150 0 9.8", &record, &issue, narrow.imu_range), LineParse::kDamaged);
+  EXPECT_EQ(issue.reason, "absurd_value");
+  EXPECT_NE(issue.detail.find("beyond ±100 (imu.max_acc_m_s2)"), std::string::npos) << issue.detail;
+  ASSERT_EQ(ParseLogLine("IMU 1.2 0 0 20 0 0 9.8", &record, &issue, narrow.imu_range), LineParse::kDamaged);
+  EXPECT_NE(issue.detail.find("beyond ±10 (imu.max_gyro_rad_s)"), std::string::npos) << issue.detail;
+  record = {};
+  record.imu.t = 1.3;
+  record.imu.acc = Vec3(250.0, 0.0, 9.8);
+  EXPECT_EQ(CheckLogRecord(&record, &issue), LineParse::kDamaged);
+  EXPECT_EQ(CheckLogRecord(&record, &issue, wide.imu_range), LineParse::kRecord);
+  record.imu.acc.x() = 150.0;
+  EXPECT_EQ(CheckLogRecord(&record, &issue), LineParse::kRecord);
+  EXPECT_EQ(CheckLogRecord(&record, &issue, narrow.imu_range), LineParse::kDamaged);
+}
+
 TEST(LogReaderStatsTest, TotalSkippedSumsAllReasons) {
   ReadStats stats;
   EXPECT_EQ(stats.total_skipped(), 0u);

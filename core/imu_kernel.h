@@ -1,11 +1,14 @@
 // The one IMU propagation kernel. The ESKF (with gravity), the preintegration (gravity zero, from the
 // identity) and the simulator's consistency tests all step through it.
 //
-// Over one interval dt with bias-corrected rate ω and specific force a held constant (first order):
-//   p' = p + v·dt + ½(R·a + g)·dt²,   v' = v + (R·a + g)·dt,   R' = R·Exp(ω·dt).
+// Over one interval dt with bias-corrected rate ω and specific force a held constant, φ = ω·dt, and the
+// specific force rotated by the attitude the body has on average over the step (second order in φ; the
+// first-order R·a lags a turning body and, with a navigation-grade IMU, is thousands of σ off in a turn):
+//   p' = p + v·dt + ½(R·(I + ⅓[φ]×)·a + g)·dt²,   v' = v + (R·(I + ½[φ]×)·a + g)·dt,   R' = R·Exp(φ).
 // With Earth rotation (core/earth.h: w is Earth-fixed, ω = ω_ib is measured against inertial space and
 // ω_ie is constant in w), the acceleration gains the Coriolis term and w turns under the body:
-//   a_w = R·a + g − 2·ω_ie×v,   p' = p + v·dt + ½a_w·dt²,   v' = v + a_w·dt,   R' = Exp(−ω_ie·dt)·R·Exp(ω·dt).
+//   both accelerations gain −2·ω_ie×v, φ is the turn against w, (ω − Rᵀω_ie)·dt, in the rotated specific
+//   force (not in R'), and R' = Exp(−ω_ie·dt)·R·Exp(ω·dt).
 // Error state (right perturbation, DESIGN §2), order δp, δv, δθ:
 //   δx' = A·δx + B·[δbg; δba] + B·[ηg; ηa] + G·δg
 // where ηg, ηa are the sensor white noises over the interval (rad/s, m/s²; discrete variance σ²/dt for
@@ -63,11 +66,14 @@ Eigen::Matrix<double, 9, N> MulA(const ImuStepJacobians& J, const Eigen::MatrixB
 
 template <int N, typename Derived>
 Eigen::Matrix<double, 9, N> MulBG(const ImuStepJacobians& J, const Eigen::MatrixBase<Derived>& Y, bool with_gravity) {
+  const auto Ybg = Y.template middleRows<3>(0);
   const auto Yba = Y.template middleRows<3>(3);
   Eigen::Matrix<double, 9, N> out;
-  out.template middleRows<3>(0) = J.B.template block<3, 3>(0, 3).lazyProduct(Yba);
-  out.template middleRows<3>(3) = J.B.template block<3, 3>(3, 3).lazyProduct(Yba);
-  out.template middleRows<3>(6) = J.B.template block<3, 3>(6, 0).lazyProduct(Y.template middleRows<3>(0));
+  out.template middleRows<3>(0) =
+      J.B.template block<3, 3>(0, 0).lazyProduct(Ybg) + J.B.template block<3, 3>(0, 3).lazyProduct(Yba);
+  out.template middleRows<3>(3) =
+      J.B.template block<3, 3>(3, 0).lazyProduct(Ybg) + J.B.template block<3, 3>(3, 3).lazyProduct(Yba);
+  out.template middleRows<3>(6) = J.B.template block<3, 3>(6, 0).lazyProduct(Ybg);
   if (with_gravity) {
     out.template middleRows<3>(0) += J.G(0, 0) * Y.template middleRows<3>(6);
     out.template middleRows<3>(3) += J.G(3, 0) * Y.template middleRows<3>(6);
@@ -105,8 +111,10 @@ Eigen::Matrix<double, N, 9> MulBGT(const ImuStepJacobians& J, const Eigen::Matri
   const auto& B = J.B;
   Eigen::Matrix<double, N, 9> out;
   for (int c = 0; c < 3; ++c) {
-    out.col(c) = B(c, 3) * YT.col(3) + B(c, 4) * YT.col(4) + B(c, 5) * YT.col(5);
-    out.col(3 + c) = B(3 + c, 3) * YT.col(3) + B(3 + c, 4) * YT.col(4) + B(3 + c, 5) * YT.col(5);
+    out.col(c) = (B(c, 0) * YT.col(0) + B(c, 1) * YT.col(1) + B(c, 2) * YT.col(2)) +
+                 (B(c, 3) * YT.col(3) + B(c, 4) * YT.col(4) + B(c, 5) * YT.col(5));
+    out.col(3 + c) = (B(3 + c, 0) * YT.col(0) + B(3 + c, 1) * YT.col(1) + B(3 + c, 2) * YT.col(2)) +
+                     (B(3 + c, 3) * YT.col(3) + B(3 + c, 4) * YT.col(4) + B(3 + c, 5) * YT.col(5));
     out.col(6 + c) = B(6 + c, 0) * YT.col(0) + B(6 + c, 1) * YT.col(1) + B(6 + c, 2) * YT.col(2);
     if (with_gravity) {
       out.col(c) += J.G(0, 0) * YT.col(6 + c);
@@ -117,19 +125,26 @@ Eigen::Matrix<double, N, 9> MulBGT(const ImuStepJacobians& J, const Eigen::Matri
 }
 
 // P += B·diag(q)·Bᵀ, the sensor noise over the step (q: the variances of [ηg; ηa], e.g. ImuDiscreteNoise's
-// diagonal), from B's three non-zero blocks: the δp and δv rows take ηa, the δθ rows ηg. P: 9×9, rows and
-// columns δp, δv, δθ (a block of a larger matrix is fine).
+// diagonal), from B's five non-zero blocks: the δp and δv rows take ηa and (through the sculling term) ηg,
+// the δθ rows ηg. P: 9×9, rows and columns δp, δv, δθ (a block of a larger matrix is fine).
 template <typename Derived>
 void AddDrivingNoise(const ImuStepJacobians& J, const Vec6& q, const Eigen::MatrixBase<Derived>& P_out) {
   auto& P = const_cast<Eigen::MatrixBase<Derived>&>(P_out);  // Eigen's idiom for writable block arguments
-  const auto Bpa = J.B.template block<3, 3>(0, 3), Bva = J.B.template block<3, 3>(3, 3);
+  const auto Bpg = J.B.template block<3, 3>(0, 0), Bpa = J.B.template block<3, 3>(0, 3);
+  const auto Bvg = J.B.template block<3, 3>(3, 0), Bva = J.B.template block<3, 3>(3, 3);
   const auto Btg = J.B.template block<3, 3>(6, 0);
   const Mat3 BpaQ = Bpa * q.tail<3>().asDiagonal(), BvaQ = Bva * q.tail<3>().asDiagonal();
-  const Mat3 Qpv = BpaQ.lazyProduct(Bva.transpose());
-  P.template block<3, 3>(0, 0) += BpaQ.lazyProduct(Bpa.transpose());
+  const Mat3 BpgQ = Bpg * q.head<3>().asDiagonal(), BvgQ = Bvg * q.head<3>().asDiagonal();
+  const Mat3 Qpv = BpaQ.lazyProduct(Bva.transpose()) + BpgQ.lazyProduct(Bvg.transpose());
+  const Mat3 Qpt = BpgQ.lazyProduct(Btg.transpose()), Qvt = BvgQ.lazyProduct(Btg.transpose());
+  P.template block<3, 3>(0, 0) += BpaQ.lazyProduct(Bpa.transpose()) + BpgQ.lazyProduct(Bpg.transpose());
   P.template block<3, 3>(0, 3) += Qpv;
   P.template block<3, 3>(3, 0) += Qpv.transpose();
-  P.template block<3, 3>(3, 3) += BvaQ.lazyProduct(Bva.transpose());
+  P.template block<3, 3>(3, 3) += BvaQ.lazyProduct(Bva.transpose()) + BvgQ.lazyProduct(Bvg.transpose());
+  P.template block<3, 3>(0, 6) += Qpt;
+  P.template block<3, 3>(6, 0) += Qpt.transpose();
+  P.template block<3, 3>(3, 6) += Qvt;
+  P.template block<3, 3>(6, 3) += Qvt.transpose();
   P.template block<3, 3>(6, 6) += (Btg * q.head<3>().asDiagonal()).lazyProduct(Btg.transpose());
 }
 

@@ -56,6 +56,12 @@ void Preintegration::Step(const Sample& s) {
   ImuStepJacobians J;
   const Kinematics y = ImuStep(x, s.gyro - bg_lin_, s.acc - ba_lin_, Vec3::Zero(), s.dt, &J);
   // Covariance and bias Jacobians use A, B at the state before the step (as the kernel defines them).
+  // A guessed step's held rate is not a sensor's reading: its error is the coast's own (held σ, white
+  // acceleration), not a turn of the specific force by the sculling term.
+  if (s.held_acc_sigma > 0.0 || !s.held_gyro_sigma.isZero(0.0)) {
+    J.B.block<3, 3>(preint::kP, preint::kBg).setZero();
+    J.B.block<3, 3>(preint::kV, preint::kBg).setZero();
+  }
   Mat6 Q = ImuDiscreteNoise(gyro_noise_density_, acc_noise_density_, s.dt);
   Q.diagonal().head<3>() += s.held_gyro_sigma.cwiseAbs2();
   Q.diagonal().tail<3>().array() += s.held_acc_sigma * s.held_acc_sigma;

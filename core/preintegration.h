@@ -2,8 +2,9 @@
 //
 // The preintegrated measurement is the IMU kinematics propagated through the one kernel (ImuStep) with
 // gravity zero from the identity, with the biases held at a linearisation point (bg_lin, ba_lin):
-//   ΔR = Π Exp((ω̃_k − bg)·dt),  Δv = Σ ΔR_k(ã_k − ba)·dt,  Δp = Σ [Δv_k·dt + ½ΔR_k(ã_k − ba)·dt²].
-// Each step uses the sample at the START of its interval, held constant (first order, as ImuStep).
+//   ΔR = Π Exp(φ_k),  Δv = Σ ΔR_k(I + ½[φ_k]×)a_k·dt,  Δp = Σ [Δv_k·dt + ½ΔR_k(I + ⅓[φ_k]×)a_k·dt²],
+// with φ_k = (ω̃_k − bg)·dt and a_k = ã_k − ba held over the step (ImuStep: the specific force rotated by
+// the attitude the body has on average over the step).
 //
 // Error order everywhere in this class (covariance rows/columns, Jacobian rows) is the kernel's:
 //   δp (0..2), δv (3..5), δθ (6..8),   Δ_true = Δ ⊞ δ  (δθ right-perturbed: ΔR_true = ΔR·Exp(δθ)).

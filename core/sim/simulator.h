@@ -26,7 +26,7 @@
 // `reverse` differs from the previous segment's must start with the vehicle stopped.
 // Yaw, pitch and speed are closed-form; the position integrates the velocity by Gauss–Legendre quadrature
 // between knots placed at every break of smoothness, so the truth is exact to round-off and independent
-// of gins's first-order IMU kernel.
+// of gins's IMU kernel.
 //
 // Sensors (DESIGN §2 IMU model, §3 log format). Time stamps are start_time + k/rate, k = 0, 1, ... (wheel
 // from k = 1: pulses count over (t − Δt, t]); records in time order, ties IMU, ODOM, GNSS, GVEL.

@@ -126,6 +126,12 @@ ceres::Solver::Options ChainSolverOptions(std::shared_ptr<ceres::ParameterBlockO
   so.function_tolerance = function_tolerance;
   so.num_threads = num_threads;
   so.logging_type = ceres::SILENT;
+  // Start close to Gauss-Newton. Ceres's default radius (1e4) damps every step by 1e-4 of the Jacobi-scaled
+  // diagonal, but a navigation-grade IMU factor's information (~1e13) dwarfs what the least-determined
+  // directions carry (yaw and the biases: ~1e3 from the fixes), so their scaled curvature is ~1e-10: the
+  // damping held those directions still for a dozen iterations, and the window left its fixes behind. Far
+  // above that ratio for any IMU grade; a step that does not pay shrinks the radius as usual.
+  so.initial_trust_region_radius = 1e12;
   return so;
 }
 

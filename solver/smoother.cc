@@ -2,6 +2,10 @@
 
 #include <glog/logging.h>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -153,10 +157,7 @@ void Smoother::AddImu(const ImuSample& imu) {
   // Without GNSS a keyframe still comes every max_keyframe_interval, so no preintegration spans an outage.
   // The 10 % grace lets a fix due at that very epoch (often logged just after the IMU sample) make the
   // keyframe itself, instead of a second solve at the same time.
-  if (t_now_ - window_.back().t >= 1.1 * options_.smoother.max_keyframe_interval) {
-    CreateKeyframe(t_now_);
-    solve_pending_ = true;
-  }
+  if (t_now_ - window_.back().t >= 1.1 * options_.smoother.max_keyframe_interval) CreateKeyframe(t_now_);
 }
 
 void Smoother::SolveIfPending() {
@@ -234,9 +235,36 @@ void Smoother::RelievePrior(double factor) {
   if (prior == nullptr) return;
   std::vector<double*> blocks;
   problem_->GetParameterBlocksForResidualBlock(prior_id_, &blocks);
-  // The same prior with its covariance `factor` times larger: J and r0 scaled by 1/√factor.
-  const double s = 1.0 / std::sqrt(factor);
-  auto relieved = std::make_unique<MarginalizationPrior>(prior->blocks(), MatX(s * prior->J()), VecX(s * prior->r0()));
+  // What a run of agreeing rejected fixes says is that the window's position is off, not its attitude,
+  // velocity or biases (the IMU between them is as good as before): the prior gains the uncertainty of one
+  // common translation d of its poses, with cov(d) = (factor − 1)·its position covariance, and keeps the
+  // rest. With T the tangent columns of the poses' positions and A = J·T, the prior ½|r0 + J·δ|² becomes
+  // ½|L·(r0 + J·δ)|² with LᵀL = (I + A·cov(d)·Aᵀ)⁻¹ (Woodbury: its information is that of Σ + T·cov(d)·Tᵀ).
+  const MatX& J = prior->J();
+  MatX T = MatX::Zero(J.cols(), 3);
+  int offset = 0;
+  for (const PriorBlock& b : prior->blocks()) {
+    if (b.kind == BlockKind::kPose) T.middleRows<3>(offset + pose::kP).setIdentity();
+    offset += b.tangent_size;
+  }
+  const MatX A = J * T;
+  // The prior's own covariance of the first pose's position (its information may be rank-deficient: the
+  // pseudo-inverse over the eigenvalues it has).
+  const Eigen::SelfAdjointEigenSolver<MatX> es(J.transpose() * J);
+  const VecX lambda = es.eigenvalues();
+  VecX inv = VecX::Zero(lambda.size());
+  for (int k = 0; k < lambda.size(); ++k) {
+    if (lambda[k] > 1e-12 * lambda.maxCoeff()) inv[k] = 1.0 / lambda[k];
+  }
+  const MatX VT = es.eigenvectors().transpose() * T.leftCols(3);
+  const MatX cov_p = VT.transpose() * inv.asDiagonal() * VT;
+  if (!cov_p.allFinite() || !(cov_p.diagonal().array() > 0.0).all()) return;
+  const MatX cov_d = (factor - 1.0) * cov_p;
+  const MatX W = (MatX::Identity(J.rows(), J.rows()) + A * cov_d * A.transpose()).inverse();
+  const Eigen::LLT<MatX> llt(0.5 * (W + W.transpose()));
+  if (llt.info() != Eigen::Success) return;
+  const MatX L = llt.matrixU();  // LᵀL = W
+  auto relieved = std::make_unique<MarginalizationPrior>(prior->blocks(), MatX(L * J), VecX(L * prior->r0()));
   problem_->RemoveResidualBlock(prior_id_);
   prior_id_ = problem_->AddResidualBlock(relieved.release(), nullptr, blocks);
 }
@@ -268,6 +296,10 @@ Keyframe& Smoother::CreateKeyframe(double t) {
                                              options_.imu.acc_noise_density);
   interval_samples_.clear();
   ++keyframes_;
+  // Every new keyframe is solved before the IMU moves on: a window left unsolved would predict the next
+  // measurement from a covariance keyframes old (a burst of rejected fixes made a keyframe per fix for
+  // their headings, and none was solved until a fix was accepted).
+  solve_pending_ = true;
   for (auto& attacher : attachers_) attacher->OnKeyframeCreated(kf, context_);
   return kf;
 }

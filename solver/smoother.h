@@ -14,8 +14,10 @@
 //
 // Robustness (config standstill.*, watchdog.*, imu.max_gap_s):
 // - GNSS: a run of rejected fixes that agree with one another inflates the gate (GateInflation); a fix
-//   accepted under it also weakens the marginalisation prior by the same factor, so the window can move to
-//   where the fixes are (re-acquisition after an outage by design, not by the watchdog).
+//   accepted under it makes the marginalisation prior's position uncertain by a common translation of its
+//   poses (the factor times its position covariance; attitude, velocity and biases kept), and joins
+//   without the robust loss, so the window moves to where the fixes are (re-acquisition after an outage or
+//   a step of the GNSS positions by design, not by the watchdog).
 // - IMU gap longer than imu.max_gap_s: preintegrated as a coast (no rotation, no acceleration from the
 //   current estimate) with the covariance of an unknown 2 m/s² and 10 deg/s held over the gap.
 // - Watchdog: when every GNSS fix for watchdog.max_reject_s (at least 3) was rejected, or the last
@@ -78,7 +80,7 @@ class Smoother : public Estimator {
   // The joint covariance of the two newest keyframes (or the newest alone) after a solve.
   // oldest_cov (optional): the oldest keyframe's too, from the same recovery.
   void UpdateNewestCovariance(MatX* oldest_cov = nullptr);
-  // A fix was accepted under an inflated gate: the prior was overconfident by about `factor`.
+  // A fix was accepted under an inflated gate: the prior's position was overconfident by about `factor`.
   void RelievePrior(double factor);
   ceres::ResidualBlockId AddImuFactor(Keyframe& prev, Keyframe& kf);
   void WatchGnss(double t, bool accepted);

@@ -68,8 +68,9 @@ GnssAttacher::GnssAttacher(const EstimatorOptions& options, std::function<void(d
 bool GnssAttacher::OnGnss(const GnssMeasurement& m, const AttachContext& ctx) {
   const Prediction pred = ctx.predict(m.t);
   const bool position = AttachPosition(m, pred, ctx);
-  if (m.heading_valid && options_.gnss.use_heading) AttachHeading(m, ctx.predict(m.t), ctx);
-  return position;
+  // A heading attached beside a rejected fix is a measurement too: the window must be solved for it.
+  const bool heading = m.heading_valid && options_.gnss.use_heading && AttachHeading(m, ctx.predict(m.t), ctx);
+  return position || heading;
 }
 
 ceres::CostFunction* GnssAttacher::PositionFactor(const GnssMeasurement& m, const Prediction& pred, const Anchor& a,
@@ -117,13 +118,15 @@ bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pr
   const Anchor a = ctx.anchor(m.t);
   std::vector<BlockRef> blocks;
   ceres::CostFunction* cost = PositionFactor(m, pred, a, ctx, &blocks);
-  ctx.keyframes.AddMeasurement(cost, loss_position_.get(), blocks, gate_position_);
+  // A fix that passed only the widened gate is far from the window in R's units: under the Huber loss it
+  // would pull with the weight of an outlier and the window could not follow it. It passed the gate: no loss.
+  ctx.keyframes.AddMeasurement(cost, inflation > 1.0 ? nullptr : loss_position_.get(), blocks, gate_position_);
   ++position_counts_.used;
   on_checked_(m.t, true);
   return true;
 }
 
-void GnssAttacher::AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx) {
+bool GnssAttacher::AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx) {
   const std::vector<BlockType> types = ctx.keyframes.EstimatedTypes();
   const StateBlocks at(pred.x);
   const std::unique_ptr<ceres::CostFunction> check_cost(
@@ -146,11 +149,12 @@ void GnssAttacher::AttachHeading(const GnssMeasurement& m, const Prediction& pre
       ceres::CostFunction* cost = factor(ctx.partial(m.t), &blocks);
       ctx.keyframes.LogRejected(cost, loss_heading_.get(), blocks, gate_heading_);
     }
-    return;
+    return false;
   }
   ceres::CostFunction* cost = factor(ctx.anchor(m.t), &blocks);
   ctx.keyframes.AddMeasurement(cost, loss_heading_.get(), blocks, gate_heading_);
   ++heading_counts_.used;
+  return true;
 }
 
 void GnssAttacher::AddStats(nlohmann::json* stats) const {

@@ -126,7 +126,7 @@ class GnssAttacher final : public MeasurementAttacher {
   ceres::CostFunction* PositionFactor(const GnssMeasurement& m, const Prediction& pred, const Anchor& a,
                                       const AttachContext& ctx, std::vector<BlockRef>* blocks) const;
   bool AttachPosition(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
-  void AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
+  bool AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
 
   EstimatorOptions options_;
   std::function<void(double, bool)> on_checked_;

@@ -133,6 +133,43 @@ TEST(RobustnessEndToEnd, BurstOfEightWildFixesIsRejectedByBothEstimators) {
   }
 }
 
+// 8 consecutive fixes alternating ±55 m north (they never agree with one another, so the gate is never
+// widened for them), each with its dual-antenna heading still valid: the headings join the window while
+// the fixes are rejected. Both estimators reject exactly the 8, no watchdog fires and the track is not
+// pulled. (The window used to make a keyframe per heading without solving it, and so checked the fix after
+// the burst against a covariance 8 s old: it rejected true fixes after a burst.)
+TEST(RobustnessEndToEnd, AlternatingBurstCostsOnlyTheBurst) {
+  for (unsigned seed : {1u, 2u}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const SimOptions sim = Shortened(test::TestDrive(seed), 100.0);
+    const Options options = test::TestRunOptions(sim);
+    const double burst_start = sim.start_time + 60.0;
+    std::vector<double> burst;
+    const Output out = RunDrive(sim, options, [&](SimRecord* r) {
+      if (r->type == SimRecord::Type::kGnss && r->gnss.t >= burst_start && burst.size() < 8) {
+        Displace(sim, Vec3(0.0, burst.size() % 2 == 0 ? 55.0 : -55.0, 0.0), &r->gnss);
+        burst.push_back(r->gnss.t);
+      }
+      return true;
+    });
+    ASSERT_EQ(burst.size(), 8u);
+    for (const nlohmann::json* stats : {&out.eskf_stats, &out.smoother_stats}) {
+      const nlohmann::json& g = (*stats)["gnss_position"];
+      std::printf("  gnss_position %s\n", g.dump().c_str());
+      EXPECT_EQ(g["rejected_times"].get<std::vector<double>>(), burst);
+      EXPECT_EQ((*stats)["watchdog"]["count"].get<size_t>(), 0u);
+    }
+    // Every keyframe was solved (the first is the initial one), so no check used a stale covariance.
+    EXPECT_GE(out.smoother_stats["solves"].get<uint64_t>() + 1, out.smoother_stats["keyframes"].get<uint64_t>());
+    const double e_eskf = MaxHorizontalError(out, out.eskf, burst.front() - 30.0, burst.back() + 30.0);
+    const double e_smoother = MaxHorizontalError(out, out.smoother, burst.front() - 30.0, burst.back() + 30.0);
+    std::printf("seed %u: max horizontal error within 30 s of the burst: eskf %.4f m, smoother %.4f m\n", seed,
+                e_eskf, e_smoother);
+    EXPECT_LT(e_eskf, 0.2);
+    EXPECT_LT(e_smoother, 0.2);
+  }
+}
+
 // A real step of the GNSS positions by 30 m that persists (say, a new reference station) is first
 // rejected, then followed: either the run of rejected fixes, all agreeing, is recognised as the estimate
 // being off (GateInflation: the gate's doubt doubles every second of the run) and a fix is accepted, or,

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "core/geodesy.h"
@@ -100,6 +101,15 @@ Vec3 PositionAt(const std::vector<StateEstimate>& states, double t) {
   return best->x.p_wb;
 }
 
+// The largest horizontal error of the ESKF and of the smoother within 30 s of a burst, printed.
+std::pair<double, double> ErrorsAroundBurst(const Output& out, const std::vector<double>& burst, unsigned seed) {
+  const double e_eskf = MaxHorizontalError(out, out.eskf, burst.front() - 30.0, burst.back() + 30.0);
+  const double e_smoother = MaxHorizontalError(out, out.smoother, burst.front() - 30.0, burst.back() + 30.0);
+  std::printf("seed %u: max horizontal error within 30 s of the burst: eskf %.4f m, smoother %.4f m\n", seed,
+              e_eskf, e_smoother);
+  return {e_eskf, e_smoother};
+}
+
 // 8 consecutive fixes displaced by 50 m while driving (uphill at ~10-14 m/s): both estimators reject
 // every one of them, list their times, and the trajectory around the burst is not pulled.
 TEST(RobustnessEndToEnd, BurstOfEightWildFixesIsRejectedByBothEstimators) {
@@ -117,10 +127,7 @@ TEST(RobustnessEndToEnd, BurstOfEightWildFixesIsRejectedByBothEstimators) {
       return true;
     });
     ASSERT_EQ(burst.size(), 8u);
-    const double e_eskf = MaxHorizontalError(out, out.eskf, burst.front() - 30.0, burst.back() + 30.0);
-    const double e_smoother = MaxHorizontalError(out, out.smoother, burst.front() - 30.0, burst.back() + 30.0);
-    std::printf("seed %u: max horizontal error within 30 s of the burst: eskf %.4f m, smoother %.4f m\n", seed,
-                e_eskf, e_smoother);
+    const auto [e_eskf, e_smoother] = ErrorsAroundBurst(out, burst, seed);
     EXPECT_LT(e_eskf, 0.5);
     EXPECT_LT(e_smoother, 0.5);
     for (const nlohmann::json* stats : {&out.eskf_stats, &out.smoother_stats}) {
@@ -161,10 +168,7 @@ TEST(RobustnessEndToEnd, AlternatingBurstCostsOnlyTheBurst) {
     }
     // Every keyframe was solved (the first is the initial one), so no check used a stale covariance.
     EXPECT_GE(out.smoother_stats["solves"].get<uint64_t>() + 1, out.smoother_stats["keyframes"].get<uint64_t>());
-    const double e_eskf = MaxHorizontalError(out, out.eskf, burst.front() - 30.0, burst.back() + 30.0);
-    const double e_smoother = MaxHorizontalError(out, out.smoother, burst.front() - 30.0, burst.back() + 30.0);
-    std::printf("seed %u: max horizontal error within 30 s of the burst: eskf %.4f m, smoother %.4f m\n", seed,
-                e_eskf, e_smoother);
+    const auto [e_eskf, e_smoother] = ErrorsAroundBurst(out, burst, seed);
     EXPECT_LT(e_eskf, 0.2);
     EXPECT_LT(e_smoother, 0.2);
   }

@@ -216,8 +216,11 @@ Anchor Smoother::PartialAt(double t) {
 void Smoother::UpdateNewestCovariance(MatX* oldest_cov) {
   const size_t n = window_.size();
   MatX trailing;
-  // On failure, the last good ones stay.
-  if (!WindowCovariances(window_, n >= 2 ? 2 : 1, &trailing, n > 2 ? oldest_cov : nullptr)) return;
+  // On failure, the last good ones stay (counted: an ill-conditioned window is never silent).
+  if (!WindowCovariances(window_, n >= 2 ? 2 : 1, &trailing, n > 2 ? oldest_cov : nullptr)) {
+    CountCovarianceFailure("the two newest keyframes' covariance");
+    return;
+  }
   const int per = static_cast<int>(trailing.rows()) / (n >= 2 ? 2 : 1);
   newest_cov_ = trailing.bottomRightCorner(per, per);
   newest_cov_id_ = window_.back().id;
@@ -225,6 +228,13 @@ void Smoother::UpdateNewestCovariance(MatX* oldest_cov) {
     newest_two_cov_ = trailing;
   } else {
     newest_two_cov_.resize(0, 0);
+  }
+}
+
+void Smoother::CountCovarianceFailure(const char* what) {
+  if (covariance_failures_++ == 0) {
+    LOG(WARNING) << "smoother: " << what << " could not be recovered at t=" << std::fixed << window_.back().t
+                 << " (information not positive definite); counted in covariance_failures";
   }
 }
 
@@ -501,7 +511,11 @@ void Smoother::MarginalizeOldest(const MatX* block_cov) {
   // Schur complement of every factor touching the oldest keyframe.
   Marginalizer marginalizer(problem_.get(), window_.Blocks(kf0));
 
-  if (have_cov) last_sigma_p_ = std::sqrt(cov.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
+  if (have_cov) {
+    last_sigma_p_ = std::sqrt(cov.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
+  } else {
+    CountCovarianceFailure("the covariance of the keyframe leaving the window");
+  }
   OutputFinal(kf0, kf1, have_cov ? &cov : nullptr);
   prior_id_ = marginalizer.Apply();
   for (auto& attacher : attachers_) attacher->OnKeyframeLeaving(kf0);
@@ -549,6 +563,7 @@ nlohmann::json Smoother::Stats() const {
   j["solves"] = solves_;
   j["iterations"] = iterations_;
   j["solver_failures"] = solver_failures_;
+  j["covariance_failures"] = covariance_failures_;
   j["solve_time_s"] = solve_time_;
   j["mean_solve_ms"] = solves_ ? 1e3 * solve_time_ / solves_ : 0.0;
   j["max_solve_ms"] = 1e3 * max_solve_time_;

@@ -82,6 +82,8 @@ class Smoother : public Estimator {
   void UpdateNewestCovariance(MatX* oldest_cov = nullptr);
   // A fix was accepted under an inflated gate: the prior's position was overconfident by about `factor`.
   void RelievePrior(double factor);
+  // A covariance recovery failed (the information is not positive definite): counted, warned once.
+  void CountCovarianceFailure(const char* what);
   ceres::ResidualBlockId AddImuFactor(Keyframe& prev, Keyframe& kf);
   void WatchGnss(double t, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
@@ -134,7 +136,7 @@ class Smoother : public Estimator {
 
   // Statistics.
   uint64_t solves_ = 0, iterations_ = 0, marginalizations_ = 0, keyframes_ = 0, reintegrations_ = 0;
-  uint64_t solver_failures_ = 0, prior_reliefs_ = 0;
+  uint64_t solver_failures_ = 0, prior_reliefs_ = 0, covariance_failures_ = 0;
   double last_scale_ = 1.0;  // of the last keyframe to leave the window
   double solve_time_ = 0.0, max_solve_time_ = 0.0, marg_time_ = 0.0;
 };

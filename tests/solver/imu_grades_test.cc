@@ -118,6 +118,10 @@ TEST_P(ImuGrades, EveryOutputHoldsWithTheTrueSpecs) {
     EXPECT_EQ(est["gnss_position"]["rejected"].size(), 0u) << est["gnss_position"].dump();
     EXPECT_EQ(est["watchdog"]["count"].get<int>(), 0);
   }
+  // Every covariance recovered: the window's at each solve and slide, the batch's at the end.
+  const nlohmann::json& smoother = run.stats["estimators"]["smoother"];
+  EXPECT_EQ(smoother["covariance_failures"].get<uint64_t>(), 0u);
+  EXPECT_TRUE(smoother["batch"]["covariance_ok"].get<bool>());
   struct Output {
     const char* name;
     const std::vector<StateEstimate>* states;

@@ -252,24 +252,28 @@ void Smoother::RelievePrior(double factor) {
   // ½|L·(r0 + J·δ)|² with LᵀL = (I + A·cov(d)·Aᵀ)⁻¹ (Woodbury: its information is that of Σ + T·cov(d)·Tᵀ).
   const MatX& J = prior->J();
   MatX T = MatX::Zero(J.cols(), 3);
-  int offset = 0;
+  int offset = 0, poses = 0;
   for (const PriorBlock& b : prior->blocks()) {
-    if (b.kind == BlockKind::kPose) T.middleRows<3>(offset + pose::kP).setIdentity();
+    if (b.kind == BlockKind::kPose) {
+      T.middleRows<3>(offset + pose::kP).setIdentity();
+      ++poses;
+    }
     offset += b.tangent_size;
   }
-  const MatX A = J * T;
-  // The prior's own covariance of the first pose's position (its information may be rank-deficient: the
-  // pseudo-inverse over the eigenvalues it has).
+  if (poses == 0) return;
+  // The prior's own covariance of its poses' mean position, Tᵀ·H⁺·T / poses² (the information may be
+  // rank-deficient: the pseudo-inverse over the eigenvalues it has).
   const Eigen::SelfAdjointEigenSolver<MatX> es(J.transpose() * J);
   const VecX lambda = es.eigenvalues();
   VecX inv = VecX::Zero(lambda.size());
   for (int k = 0; k < lambda.size(); ++k) {
     if (lambda[k] > 1e-12 * lambda.maxCoeff()) inv[k] = 1.0 / lambda[k];
   }
-  const MatX VT = es.eigenvectors().transpose() * T.leftCols(3);
-  const MatX cov_p = VT.transpose() * inv.asDiagonal() * VT;
+  const MatX VT = es.eigenvectors().transpose() * T;
+  const MatX cov_p = VT.transpose() * inv.asDiagonal() * VT / static_cast<double>(poses * poses);
   if (!cov_p.allFinite() || !(cov_p.diagonal().array() > 0.0).all()) return;
   const MatX cov_d = (factor - 1.0) * cov_p;
+  const MatX A = J * T;
   const MatX W = (MatX::Identity(J.rows(), J.rows()) + A * cov_d * A.transpose()).inverse();
   const Eigen::LLT<MatX> llt(0.5 * (W + W.transpose()));
   if (llt.info() != Eigen::Success) return;

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <ostream>
 #include <string>
 #include <tuple>
 
@@ -35,6 +36,11 @@ constexpr Grade kGrades[] = {
 enum class Gnss { kRtk, kSpp };
 // And the vehicle's aids: none (no heading, no wheels), or 10 Hz wheel pulses and a dual-antenna heading.
 enum class Aids { kNone, kWheelsAndHeading };
+
+// Test names and failure messages print the cell, not its bytes.
+void PrintTo(const Grade& g, std::ostream* os) { *os << g.name; }
+void PrintTo(Gnss g, std::ostream* os) { *os << (g == Gnss::kRtk ? "rtk" : "spp"); }
+void PrintTo(Aids a, std::ostream* os) { *os << (a == Aids::kNone ? "no aids" : "wheels and heading"); }
 
 struct Cell {
   Grade grade;

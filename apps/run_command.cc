@@ -107,6 +107,7 @@ nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nloh
   input["odom_ignored_wheel_disabled"] = session_stats["odom_ignored_wheel_disabled"];
   input["gvel_unused"] = session_stats["gvel_unused"];
   input["dropped_before_first_fix"] = session_stats["dropped_before_first_fix"];
+  input["rest_states_before_initialization"] = session_stats["rest_states_before_initialization"];
   // The API's reorder buffer (input.reorder_window_s): records sorted into place, and those refused (a
   // log's late records are out_of_order damage above, so "refused" stays empty for a log).
   nlohmann::json refused = nlohmann::json::object();

@@ -55,6 +55,12 @@ inline double EnuYawToCompassDeg(double yaw) {
   return h < 0.0 ? h + 360.0 : h;
 }
 
+// The yaw's 1-σ when nothing is known of it: that of a uniform angle on the circle, π/√3 (104°). An estimate
+// with it (a state at rest before the initialisation, core/initializer.h) has no yaw: evaluations leave its
+// attitude out (core/eval/trajectory_metrics.h). Any σ of at least kUnknownYawSigmaBound reads as unknown.
+inline constexpr double kUnknownYawSigma = 1.8137993642342178;
+inline constexpr double kUnknownYawSigmaBound = 0.99 * kUnknownYawSigma;
+
 inline Vec3 GravityWorld(double g_norm) { return Vec3(0.0, 0.0, -g_norm); }
 
 }  // namespace gins

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "core/chi2.h"
 #include "core/so3.h"
@@ -48,6 +49,9 @@ constexpr double kMaxSettledYawSigma = 30.0 * kDegToRad;
 // at 3 σ (15°) the linearised gravity is off by 1 − cos 15° ≈ 3 % of g, which the iterated update absorbs.
 constexpr double kMaxSettledTiltSigma = 5.0 * kDegToRad;
 // Floors of the initial covariance (1-σ): the estimators invert it.
+// Gyrocompassing at rest gives a yaw when its 1-σ is at most this (rad); beyond, the linearised σ means
+// little and the yaw is taken as unknown.
+constexpr double kMaxGyrocompassSigma = 15.0 * kDegToRad;
 constexpr double kFloorPos = 1e-3, kFloorVel = 1e-3, kFloorAtt = 1e-5, kFloorBg = 1e-7, kFloorBa = 1e-5;
 
 std::string Deg(double rad) {
@@ -212,7 +216,7 @@ void Initializer::TryStandingWithHeading(const GnssMeasurement& fix) {
     last_problem_ = "standing still with a heading, but the fit failed: " + a.problem;
     return;
   }
-  Finish(a, fix, standing_);
+  Finish(a, fix, standing_, {});
 }
 
 bool Initializer::Moved(const AlignmentInput& in) const {
@@ -280,7 +284,7 @@ void Initializer::TryFit(const GnssMeasurement& fix) {
     return;
   }
   if (!Acceptable(a, full)) return;
-  Finish(a, fix, from_standstill ? last_standstill_ : std::nullopt);
+  Finish(a, fix, from_standstill ? last_standstill_ : std::nullopt, std::move(in.imu));
 }
 
 bool FitStartsEstimators(const AlignmentFit& a, bool window_full, double max_attitude_sigma, double max_tilt_sigma) {
@@ -314,7 +318,8 @@ bool Initializer::Acceptable(const AlignmentFit& a, bool window_full) {
   return FitStartsEstimators(a, window_full, max_att, max_tilt);
 }
 
-void Initializer::Finish(const AlignmentFit& a, const GnssMeasurement& fix, const std::optional<Standstill>& standstill) {
+void Initializer::Finish(const AlignmentFit& a, const GnssMeasurement& fix, const std::optional<Standstill>& standstill,
+                         std::vector<ImuSample> fit_imu) {
   InitResult r;
   r.x0 = a.x;
   r.x0.t = fix.t;
@@ -340,10 +345,82 @@ void Initializer::Finish(const AlignmentFit& a, const GnssMeasurement& fix, cons
   r.yaw_sigma = a.yaw_sigma;
   r.tilt_sigma = a.tilt_sigma;
   r.window_start = a.x0.t;
+  r.fit_start = a.x0;
+  r.fit_start_P = 0.5 * (a.P0 + a.P0.transpose());
+  for (int b = 0; b < 5; ++b) r.fit_start_P.block<3, 3>(3 * b, 3 * b).diagonal().array() += floors[b] * floors[b];
+  r.fit_imu = std::move(fit_imu);
   r.chi2_per_dof = a.chi2 / std::max(1, a.dof);
   r.inflation = a.inflation;
   r.runner_up_delta_chi2 = a.runner_up_delta_chi2;
   result_ = r;
+}
+
+void Initializer::RestStates(double after, std::vector<RestState>* out) const {
+  if (done() || !standing_ || standing_->fixes.empty() || imu_.empty()) return;
+  const StaticSummary& st = standing_->summary;
+  if (!(st.acc_mean.norm() > 0.0)) return;
+  const double from = std::max(st.t_start, standing_->fixes.front().t);
+  RestState r;
+  // Level from gravity; an accelerometer bias tilts the measured gravity by up to its σ over g.
+  const double g = earth_.g_norm();
+  const double tilt = std::hypot(options_.imu.init_acc_bias_sigma / g,
+                                 st.acc_std.mean() / std::sqrt(std::max(1, st.n)) / g);
+  const Quat q_level = Quat::FromTwoVectors(st.acc_mean.normalized(), Vec3::UnitZ());
+  const Quat q0 = (QuatFromYaw(-YawOfXAxis<double>(q_level.toRotationMatrix())) * q_level).normalized();
+  // The yaw from the Earth's rotation (gyrocompassing): the mean rate, levelled, points its horizontal part
+  // north, off by the gyro bias and the mean's noise over the rotation's horizontal part. A tactical or
+  // navigation-grade IMU resolves it to degrees; a MEMS gyro's bias is far larger than the Earth's rate:
+  // then any yaw is as likely (0, with the σ of a uniform angle).
+  double yaw = 0.0, yaw_sigma = kUnknownYawSigma;
+  const Vec3 rate_w = earth_.rate_w();
+  const double rate_h = rate_w.head<2>().norm();
+  if (rate_h > 0.0 && st.t_end > st.t_start) {
+    const Vec3 u = q0 * st.gyro_mean;
+    const double noise = options_.imu.gyro_noise_density / std::sqrt(st.t_end - st.t_start);
+    const double sigma_h = std::sqrt(std::pow(options_.imu.init_gyro_bias_sigma, 2) + noise * noise +
+                                     std::pow(tilt * rate_w.z(), 2));
+    if (sigma_h / rate_h <= kMaxGyrocompassSigma) {
+      yaw = WrapAngle(std::atan2(rate_w.y(), rate_w.x()) - std::atan2(u.y(), u.x()));
+      yaw_sigma = sigma_h / rate_h;
+    }
+  }
+  // A dual-antenna heading at this standstill (the newest valid one) is better still.
+  if (options_.gnss.use_heading) {
+    for (auto f = standing_->fixes.rbegin(); f != standing_->fixes.rend(); ++f) {
+      if (!f->heading_valid) continue;
+      const double m = options_.gnss.mount_yaw;
+      const Vec3 x_G = q0 * Vec3(std::cos(m), std::sin(m), 0.0);  // the antennas' baseline, level, yaw 0
+      yaw = WrapAngle(f->yaw_G - std::atan2(x_G.y(), x_G.x()));
+      yaw_sigma = f->sigma_yaw;
+      break;
+    }
+  }
+  r.x.q_wb = (QuatFromYaw(yaw) * q0).normalized();
+  // The antenna: the fixes' weighted mean (each σ already covers the fixes' correlation, gnss_noise.h).
+  Vec3 info = Vec3::Zero(), sum = Vec3::Zero();
+  for (const GnssMeasurement& f : standing_->fixes) {
+    const Vec3 w = f.sigma_w.cwiseAbs2().cwiseInverse();
+    info += w;
+    sum += w.cwiseProduct(f.p_w);
+  }
+  const Vec3 p_antenna = sum.cwiseQuotient(info);
+  // The IMU point: the lever arm's vertical part is known from the tilt; its horizontal part turns with the
+  // yaw (for an unknown yaw a circle about the antenna: a mean of zero, a variance of half its squared
+  // radius; else its arc over the yaw's σ).
+  const Vec3 lever_w = r.x.q_wb * options_.gnss.lever_b;
+  const bool yaw_known = yaw_sigma < kUnknownYawSigma;
+  r.x.p_wb = p_antenna - (yaw_known ? lever_w : Vec3(0.0, 0.0, lever_w.z()));
+  const double lever_var = lever_w.head<2>().squaredNorm() * (yaw_known ? yaw_sigma * yaw_sigma : 0.5);
+  r.sigma_p = (info.cwiseInverse() + Vec3(lever_var, lever_var, 0.0)).cwiseSqrt();
+  r.sigma_v.setConstant(options_.standstill.velocity_sigma);
+  r.sigma_att = Vec3(tilt, tilt, yaw_sigma);
+  const size_t first = out->size();
+  for (auto it = imu_.rbegin(); it != imu_.rend() && it->t > after; ++it) {
+    if (it->t < from) break;
+    r.x.t = it->t;
+    out->push_back(r);
+  }
+  std::reverse(out->begin() + static_cast<std::ptrdiff_t>(first), out->end());
 }
 
 std::string Initializer::Diagnosis() const {

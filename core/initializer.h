@@ -21,6 +21,11 @@
 // fixes' σ (ImuWindowForSigma, 5-60 s), and it restarts after an IMU gap.
 // The estimators start at the completing GNSS epoch with the fit's state and covariance there, having used
 // every earlier measurement through the initialiser (no measurement is used twice).
+// Before that, while the vehicle stands and a fix has come, what is known is written (RestStates): the
+// position of the standstill's fixes, a zero velocity, roll and pitch from gravity, and the yaw from the
+// Earth's rotation when the gyro's stated bias σ resolves it (gyrocompassing: tactical and navigation-grade
+// IMUs), else a yaw of 0 with the σ of a uniformly unknown angle (π/√3); the two-sided outputs later give
+// those epochs the yaw found from the motion (solver/pre_init_output.h).
 #pragma once
 
 #include <deque>
@@ -69,6 +74,9 @@ struct InitResult {
   std::string standstill_witness;  // "wheels" | "gnss_velocity" | "gnss_position" | "" (no standstill)
   double yaw_sigma = 0.0, tilt_sigma = 0.0;  // rad, of P0
   double window_start = 0.0;      // the fit's first epoch
+  NavState fit_start;             // the fit's state there (at window_start) and its covariance
+  Mat15 fit_start_P = Mat15::Identity();
+  std::vector<ImuSample> fit_imu;  // the fit's IMU samples (body axes), from window_start to x0.t
   double chi2_per_dof = 0.0, inflation = 1.0, runner_up_delta_chi2 = 0.0;
 };
 
@@ -78,6 +86,12 @@ struct InitResult {
 // gets (window_full), a settled fit: yaw σ up to 30°, roll/pitch σ up to 5°, the other yaw ruled out at the
 // plain quantile.
 bool FitStartsEstimators(const AlignmentFit& a, bool window_full, double max_attitude_sigma, double max_tilt_sigma);
+
+// A state at rest before the initialisation completes (Initializer::RestStates): 1-σ about the world axes.
+struct RestState {
+  NavState x;
+  Vec3 sigma_p = Vec3::Zero(), sigma_v = Vec3::Zero(), sigma_att = Vec3::Zero();
+};
 
 class Initializer {
  public:
@@ -93,6 +107,10 @@ class Initializer {
 
   bool done() const { return result_.has_value(); }
   const InitResult& result() const { return *result_; }
+  // The states at rest after `after` and not after the newest IMU sample, one per IMU sample, appended to
+  // *out in time order: while standing (the detector's window back-dated to where the quiet began), from
+  // the standstill's first fix on; none before the initialisation completes otherwise.
+  void RestStates(double after, std::vector<RestState>* out) const;
   // Why initialisation has not completed, for the error message at the end of a log.
   std::string Diagnosis() const;
 
@@ -116,7 +134,8 @@ class Initializer {
   bool Acceptable(const AlignmentFit& a, bool window_full);
   void TryStandingWithHeading(const GnssMeasurement& fix);
   void TryFit(const GnssMeasurement& fix);
-  void Finish(const AlignmentFit& a, const GnssMeasurement& fix, const std::optional<Standstill>& standstill);
+  void Finish(const AlignmentFit& a, const GnssMeasurement& fix, const std::optional<Standstill>& standstill,
+              std::vector<ImuSample> fit_imu);
 
   InitializerOptions options_;
   EarthModel earth_;

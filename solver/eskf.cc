@@ -42,10 +42,13 @@ void Eskf::Finish() {
   FlushCovariance();
   if (!rts_) return;
   rts_->AfterUpdates(Nominal(), P_);
-  rts_->Smooth(earth_, on_rts_);
+  rts_->Smooth(earth_, pre_init_.TwoSided(on_rts_));
 }
 
+void Eskf::AddRestState(const StateEstimate& s) { pre_init_.Add(s, on_rts_ != nullptr, on_state_); }
+
 void Eskf::Initialize(const InitResult& init) {
+  pre_init_.Start(init, on_state_);
   x_ = init.x0;
   earth_ = init.earth;
   dg_w_.setZero();

@@ -43,6 +43,7 @@
 #include "solver/eskf_update.h"
 #include "solver/estimator.h"
 #include "solver/estimator_options.h"
+#include "solver/pre_init_output.h"
 
 namespace gins {
 
@@ -62,6 +63,7 @@ class Eskf : public Estimator {
   void AddGvel(const GvelMeasurement& gvel) override;
   void AddWheel(const WheelMeasurement& wheel) override;
   void AddStandstill(const StandstillMeasurement& m) override;
+  void AddRestState(const StateEstimate& s) override;
   void Finish() override;
   nlohmann::json Stats() const override;
 
@@ -130,6 +132,7 @@ class Eskf : public Estimator {
   EstimatorOptions options_;
   StateCallback on_state_;
   StateCallback on_rts_;
+  PreInitOutput pre_init_{BridgeNoise{options_.imu.gyro_noise_density, options_.imu.acc_noise_density}};
   std::unique_ptr<EskfRts> rts_;  // with on_rts_
   bool initialized_ = false;
   NavState x_;

@@ -186,6 +186,10 @@ class Estimator {
   // The vehicle stands (the session's detector: wheels at zero and IMU quiet, or IMU quiet without
   // wheels); sent at most every 0.1 s while it stands, right after the IMU sample at m.t.
   virtual void AddStandstill(const StandstillMeasurement& m) = 0;
+  // Before Initialize: a state at rest that the initialiser knows without a yaw (Initializer::RestStates),
+  // in time order and before the initialisation's time; written to the forward outputs, and to the
+  // two-sided ones with the yaw found later (solver/pre_init_output.h).
+  virtual void AddRestState(const StateEstimate& s) = 0;
   // End of the log: flush everything still held.
   virtual void Finish() = 0;
   virtual nlohmann::json Stats() const = 0;

@@ -201,6 +201,7 @@ void Session::AddImu(const ImuSample& raw) {
     }
   } else if (!initialized_) {
     init_->AddImu(s);
+    SendRestStates();
   } else {
     Dispatch(&Estimator::AddImu, s);
   }
@@ -208,6 +209,38 @@ void Session::AddImu(const ImuSample& raw) {
     standstill_->AddImu(s);
     if (initialized_) DetectStandstill(s.t);
   }
+}
+
+namespace {
+StateEstimate RestEstimate(const RestState& r) {
+  StateEstimate e;
+  e.x = r.x;
+  e.sigma_p = r.sigma_p;
+  e.sigma_v = r.sigma_v;
+  e.sigma_att = r.sigma_att;
+  return e;
+}
+}  // namespace
+
+void Session::SendRestStates() {
+  rest_scratch_.clear();
+  init_->RestStates(last_rest_t_, &rest_scratch_);
+  for (const RestState& r : rest_scratch_) {
+    if (rest_held_) {
+      Dispatch(&Estimator::AddRestState, RestEstimate(*rest_held_));
+      ++rest_sent_;
+    }
+    rest_held_ = r;
+    last_rest_t_ = r.x.t;
+  }
+}
+
+void Session::FlushRestState(double init_t) {
+  if (rest_held_ && rest_held_->x.t < init_t) {
+    Dispatch(&Estimator::AddRestState, RestEstimate(*rest_held_));
+    ++rest_sent_;
+  }
+  rest_held_.reset();
 }
 
 void Session::DetectStandstill(double t) {
@@ -306,7 +339,10 @@ void Session::AddGnss(const GnssRecord& g) {
     init_->AddGnss(m);
     if (init_->done()) {
       initialized_ = true;
+      FlushRestState(init_->result().x0.t);
       Dispatch(&Estimator::Initialize, init_->result());
+    } else {
+      SendRestStates();
     }
   } else {
     Dispatch(&Estimator::AddGnss, m);
@@ -367,6 +403,7 @@ nlohmann::json Session::Stats() const {
   j["wheel_gaps"] = wheel_gaps_;
   j["dropped_before_first_fix"] = pending_dropped_;
   j["standstill_updates"] = standstill_sent_;
+  j["rest_states_before_initialization"] = rest_sent_;
   // Simulated outages as absolute [begin, end) windows, and the log's own GNSS gaps.
   nlohmann::json outages = nlohmann::json::array(), gaps = nlohmann::json::array();
   if (first_t_ >= 0.0) {

@@ -112,6 +112,15 @@ class Session {
   int imu_candidate_runs_ = 0;
   uint64_t imu_jitter_ = 0, imu_rate_changes_ = 0, imu_same_stamp_ = 0;
 
+  // States at rest before initialisation (Initializer::RestStates), to every estimator. The newest is held
+  // back until a later one comes: at the initialisation it is dropped if the estimators start at its time.
+  void SendRestStates();
+  void FlushRestState(double init_t);
+  std::vector<RestState> rest_scratch_;
+  std::optional<RestState> rest_held_;
+  double last_rest_t_ = -1e300;
+  uint64_t rest_sent_ = 0;
+
   // Standstill detection (core/standstill_detector.h), fed from the initialiser's start; after
   // initialisation a StandstillMeasurement goes to every estimator every 0.1 s while the vehicle stands.
   void DetectStandstill(double t);

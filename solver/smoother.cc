@@ -59,7 +59,10 @@ Smoother::~Smoother() = default;
 
 NavState Smoother::NewestState() const { return window_.back().State(); }
 
+void Smoother::AddRestState(const StateEstimate& s) { pre_init_.Add(s, on_batch_ != nullptr, on_final_, on_online_); }
+
 void Smoother::Initialize(const InitResult& init) {
+  pre_init_.Start(init, on_final_);  // the online stream is for the newest state: not the late window
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -556,7 +559,7 @@ void Smoother::Finish() {
   if (on_batch_) {
     BatchSmoother batch(options_, window_.EstimatedTypes());
     batch.Solve(factor_log_.get(), earth_);
-    batch.Emit(*factor_log_, earth_, on_batch_);
+    batch.Emit(*factor_log_, earth_, pre_init_.TwoSided(on_batch_));
     batch_stats_ = batch.stats().ToJson();
   }
 }

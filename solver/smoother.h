@@ -38,6 +38,7 @@
 #include "factors/pose_manifold.h"
 #include "solver/estimator.h"
 #include "solver/estimator_options.h"
+#include "solver/pre_init_output.h"
 #include "solver/factor_log.h"
 #include "solver/keyframe.h"
 #include "solver/smoother_attachers.h"
@@ -59,6 +60,7 @@ class Smoother : public Estimator {
   void AddGvel(const GvelMeasurement& gvel) override;
   void AddWheel(const WheelMeasurement& wheel) override;
   void AddStandstill(const StandstillMeasurement& m) override;
+  void AddRestState(const StateEstimate& s) override;
   void Finish() override;
   nlohmann::json Stats() const override;
 
@@ -103,6 +105,7 @@ class Smoother : public Estimator {
   bool initialized_ = false;
 
   StateCallback on_batch_;
+  PreInitOutput pre_init_{BridgeNoise{options_.imu.gyro_noise_density, options_.imu.acc_noise_density}};
   std::unique_ptr<FactorLog> factor_log_;  // with on_batch_; before window_, which records into it
   nlohmann::json batch_stats_;
   KeyframeStore window_;

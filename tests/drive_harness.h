@@ -98,6 +98,14 @@ void ForEachAtTruth(const DriveRun& run, const std::vector<StateEstimate>& state
   }
 }
 
+// Share of the IMU epochs from `from` on at which a stream has a state.
+inline double Coverage(const DriveRun& run, const std::vector<StateEstimate>& states, double from) {
+  size_t epochs = 0, covered = 0;
+  for (double t : run.truth_t) epochs += t >= from;
+  ForEachAtTruth(run, states, from, 1e300, [&](const StateEstimate&, size_t) { ++covered; });
+  return epochs > 0 ? static_cast<double>(covered) / static_cast<double>(epochs) : 0.0;
+}
+
 // Errors of the states with t in [from, to) against the truth at the same IMU time.
 inline DriveErrors Errors(const DriveRun& run, const std::vector<StateEstimate>& states, double from,
                           double to = 1e300) {

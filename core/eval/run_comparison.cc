@@ -29,6 +29,7 @@ nlohmann::json MetricsToJson(const TrajectoryMetrics& m, double time_origin) {
   j["rmse_attitude_deg"] = m.rmse_att_deg;
   j["rmse_heading_deg"] = m.rmse_heading_deg;
   j["max_heading_deg"] = m.max_heading_deg;
+  j["attitude_samples"] = m.attitude_samples;
   nlohmann::json rel;
   rel["segment_length_m"] = m.segment_length;
   rel["segments"] = m.segments;
@@ -210,6 +211,7 @@ nlohmann::json AccuracyToJson(const TrajectoryMetrics* m) {
   j["rmse_velocity_m_s"] = m && m->rmse_vel ? nlohmann::json(*m->rmse_vel) : nlohmann::json();
   j["rmse_heading_deg"] = number(m ? m->rmse_heading_deg : 0.0);
   j["rmse_attitude_deg"] = number(m ? m->rmse_att_deg : 0.0);
+  j["attitude_samples"] = m ? m->attitude_samples : 0;
   return j;
 }
 

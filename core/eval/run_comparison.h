@@ -19,7 +19,7 @@ nlohmann::json MetricsToJson(const TrajectoryMetrics& m, double time_origin);
 
 // summary.json's short "accuracy.<stream>" form of the same metrics (keys as in MetricsToJson: samples,
 // rmse_3d_m, rmse_horizontal_m, rmse_vertical_m, max_horizontal_m, rmse_velocity_m_s, rmse_heading_deg,
-// rmse_attitude_deg). Null `m` (nothing evaluated): samples 0 and null numbers rather than zeros, which
+// rmse_attitude_deg, attitude_samples: the pairs where both have a yaw). Null `m` (nothing evaluated): samples 0 and null numbers rather than zeros, which
 // would read as a perfect score.
 nlohmann::json AccuracyToJson(const TrajectoryMetrics* m);
 

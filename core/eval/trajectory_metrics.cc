@@ -160,6 +160,7 @@ EstimateMatcher::Result EstimateMatcher::At(double t, TrajectorySample* est) {
   est->p_w = (1.0 - f) * a_.p_w + f * b_.p_w;
   est->v_w = (1.0 - f) * a_.v_w + f * b_.v_w;
   est->q_wb = a_.q_wb.slerp(f, b_.q_wb);
+  est->yaw_known = a_.yaw_known && b_.yaw_known;
   return Result::kMatched;
 }
 
@@ -256,11 +257,14 @@ void TrajectoryEvaluator::AddPair(const TrajectorySample& ref, const TrajectoryS
     t_max_h_ = ref.t;
   }
   svel_ += (est.v_w - ref.v_w).squaredNorm();
-  satt_ += LogQuat<double>(ref.q_wb.conjugate() * est.q_wb).squaredNorm();
-  const double dyaw =
-      WrapAngle(YawOfXAxis<double>(est.q_wb.toRotationMatrix()) - YawOfXAxis<double>(ref.q_wb.toRotationMatrix()));
-  syaw_ += dyaw * dyaw;
-  max_heading_deg_ = std::max(max_heading_deg_, std::abs(dyaw) * kRadToDeg);
+  if (ref.yaw_known && est.yaw_known) {
+    satt_ += LogQuat<double>(ref.q_wb.conjugate() * est.q_wb).squaredNorm();
+    const double dyaw =
+        WrapAngle(YawOfXAxis<double>(est.q_wb.toRotationMatrix()) - YawOfXAxis<double>(ref.q_wb.toRotationMatrix()));
+    syaw_ += dyaw * dyaw;
+    max_heading_deg_ = std::max(max_heading_deg_, std::abs(dyaw) * kRadToDeg);
+    ++attitude_samples_;
+  }
   ++samples_;
 
   // Relative error: this pair ends the segments of the open starts it is segment_length or more beyond (the
@@ -326,8 +330,10 @@ TrajectoryMetrics TrajectoryEvaluator::Metrics() const {
   m.max_h = max_h_;
   m.t_max_h = t_max_h_;
   if (with_velocity_) m.rmse_vel = std::sqrt(svel_ / n);
-  m.rmse_att_deg = std::sqrt(satt_ / n) * kRadToDeg;
-  m.rmse_heading_deg = std::sqrt(syaw_ / n) * kRadToDeg;
+  m.attitude_samples = attitude_samples_;
+  const double n_att = static_cast<double>(std::max<uint64_t>(attitude_samples_, 1));
+  m.rmse_att_deg = std::sqrt(satt_ / n_att) * kRadToDeg;
+  m.rmse_heading_deg = std::sqrt(syaw_ / n_att) * kRadToDeg;
   m.max_heading_deg = max_heading_deg_;
 
   m.segment_length = options_.segment_length;

@@ -11,7 +11,8 @@
 // - Position errors e = p_est − p_ref: 3-D, horizontal |e_EN| and vertical e_U RMSE; largest horizontal.
 // - Velocity RMSE |v_est − v_ref| when both carry velocities.
 // - Attitude RMSE: RMS of |Log(R_refᵀ R_est)|; heading: RMS of the wrapped difference of the yaws of the body
-//   x axes (ENU, about up).
+//   x axes (ENU, about up). Both over the pairs where both have a yaw: an estimate whose yaw σ says it has
+//   none (a state CSV's sigma_att_u of kUnknownYawSigma: at rest before the initialisation) is left out.
 // - Relative error over travelled distance L (default 100 m): from every pair i, the first pair j at
 //   which the reference has travelled (3-D path length) at least L, with no unevaluated reference sample
 //   between them; error = |(p_est,j − p_est,i) − (p_ref,j − p_ref,i)| / d_ij · 100 %, d_ij the reference's
@@ -151,7 +152,9 @@ struct TrajectoryMetrics {
   double rmse_3d = 0.0, rmse_h = 0.0, rmse_v = 0.0, rmse_e = 0.0, rmse_n = 0.0;
   double mean_h = 0.0, max_h = 0.0, t_max_h = 0.0;
   std::optional<double> rmse_vel;  // m/s; when both have velocities
+  // Over the pairs where both have a yaw (attitude_samples; TrajectorySample::yaw_known).
   double rmse_att_deg = 0.0, rmse_heading_deg = 0.0, max_heading_deg = 0.0;
+  uint64_t attitude_samples = 0;
   // Relative error over travelled distance.
   double segment_length = 0.0;
   uint64_t segments = 0;
@@ -196,7 +199,7 @@ class TrajectoryEvaluator {
   MetricOptions options_;
   RigidTransform align_;
   Quat q_align_;
-  uint64_t samples_ = 0, reference_in_span_ = 0;
+  uint64_t samples_ = 0, reference_in_span_ = 0, attitude_samples_ = 0;
   // Absolute errors: sums of squares over the pairs (E, N, U, velocity, attitude, heading).
   double se_ = 0.0, sn_ = 0.0, su_ = 0.0, sum_h_ = 0.0, svel_ = 0.0, satt_ = 0.0, syaw_ = 0.0;
   double max_h_ = 0.0, t_max_h_ = 0.0, max_heading_deg_ = 0.0;

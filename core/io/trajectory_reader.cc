@@ -141,6 +141,7 @@ bool TrajectoryReader::ReadRow(TrajectorySample* sample) {
         col_.vz = index["vz"];
         has_velocity_ = true;
       }
+      if (index.count("sigma_att_u")) col_.sigma_att_u = index["sigma_att_u"];
       col_.count = fields_.size();
       header_seen_ = true;
       continue;
@@ -160,6 +161,7 @@ bool TrajectoryReader::ReadRow(TrajectorySample* sample) {
     if (q.norm() < 0.5 || q.norm() > 2.0) Fail("quaternion is not a rotation (norm " + std::to_string(q.norm()) + ")");
     s.q_wb = q.normalized();
     if (has_velocity_) s.v_w = Vec3(v[col_.vx], v[col_.vy], v[col_.vz]);
+    if (col_.sigma_att_u >= 0) s.yaw_known = v[col_.sigma_att_u] < kUnknownYawSigmaBound;
     *sample = s;
     row_seen_ = true;
     return true;

@@ -20,6 +20,8 @@ struct TrajectorySample {
   Vec3 p_w = Vec3::Zero();
   Quat q_wb = Quat::Identity();
   Vec3 v_w = Vec3::Zero();
+  // False when a state CSV's sigma_att_u says the estimate has no yaw there (kUnknownYawSigma).
+  bool yaw_known = true;
 };
 
 struct Trajectory {
@@ -72,6 +74,7 @@ class TrajectoryReader {
   struct Columns {
     int t = 0, px = 1, py = 2, pz = 3, qx = 4, qy = 5, qz = 6, qw = 7;
     int vx = -1, vy = -1, vz = -1;
+    int sigma_att_u = -1;
     size_t count = 8;
   } col_;
   std::string line_;                               // reused: no allocation per row

@@ -267,9 +267,12 @@ TEST_F(CliRun, RunBoth) {
   const uint64_t solves = s["estimators"]["smoother"]["solves"].get<uint64_t>();
   EXPECT_GT(solves, 0u);
   EXPECT_TRUE(s["estimators"].contains("eskf"));
-  // The online stream: the initial keyframe and one state per solve.
-  EXPECT_EQ(s["outputs"]["smoother_online"]["states"].get<uint64_t>(), solves + 1);
-  EXPECT_EQ(online.size() - 1, solves + 1);
+  // The online stream: the states at rest before the initialisation, the initial keyframe and one state per
+  // solve.
+  const uint64_t rest = s["input"]["rest_states_before_initialization"].get<uint64_t>();
+  EXPECT_GT(rest, 0u);
+  EXPECT_EQ(s["outputs"]["smoother_online"]["states"].get<uint64_t>(), rest + solves + 1);
+  EXPECT_EQ(online.size() - 1, rest + solves + 1);
   for (const char* name : {"eskf", "smoother", "smoother_online"}) {
     EXPECT_TRUE(s["accuracy"].contains(name)) << name;
     EXPECT_EQ(s["outputs"][name]["non_finite_skipped"].get<uint64_t>(), 0u) << name;

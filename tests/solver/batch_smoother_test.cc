@@ -119,6 +119,9 @@ TEST(BatchEndToEnd, EqualsTheWindowWhenTheWindowSpansTheDrive) {
   size_t keyframes = 0;
   for (size_t i = 0; i < run.batch.size(); ++i) {
     ASSERT_EQ(run.batch[i].x.t, run.smoother[i].x.t);
+    // Before the initialisation the window writes the rest states (yaw unknown), the batch its first
+    // state carried back (solver/pre_init_output.h): the solutions start at the initialisation.
+    if (run.batch[i].x.t < run.init_t) continue;
     const double since_start = run.batch[i].x.t - sim.start_time;
     if (std::abs(since_start - std::round(since_start)) > 1e-6) continue;
     ++keyframes;

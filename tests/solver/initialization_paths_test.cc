@@ -6,9 +6,12 @@
 // of the path (a wrong yaw, a start much later, a yaw σ that does not cover the error) fails.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "drive_harness.h"
 #include "test_scenarios.h"
@@ -36,6 +39,14 @@ EstimatorOptions SppOptions(const SimOptions& sim) {
   return o;
 }
 
+// The state at time t of a stream (nullptr: none).
+const StateEstimate* StateAt(const std::vector<StateEstimate>& states, double t) {
+  for (const StateEstimate& s : states) {
+    if (std::abs(s.x.t - t) < 1e-9) return &s;
+  }
+  return nullptr;
+}
+
 struct Outcome {
   test::DriveRun run;
   double init_after = 0.0;  // s after the first record
@@ -52,9 +63,10 @@ Outcome RunAndScore(const SimOptions& sim, const EstimatorOptions& options, cons
   o.init_after = o.run.init_t - o.run.first_t;
   const nlohmann::json& init = o.run.stats["initialization"];
   o.yaw_sigma_at_init = init["yaw_sigma_deg"].get<double>();
+  const StateEstimate* at_init = StateAt(o.run.eskf, o.run.init_t);
   for (size_t i = 0; i < o.run.truth_t.size(); ++i) {
-    if (std::abs(o.run.truth_t[i] - o.run.init_t) < 1e-6 && !o.run.eskf.empty()) {
-      const NavState& x = o.run.eskf.front().x;
+    if (std::abs(o.run.truth_t[i] - o.run.init_t) < 1e-6 && at_init) {
+      const NavState& x = at_init->x;
       o.yaw_error_at_init =
           WrapAngle(YawOfXAxis<double>(x.R_wb()) - YawOfXAxis<double>(o.run.truth[i].R_wb())) * kRadToDeg;
     }
@@ -107,6 +119,63 @@ TEST(InitializationPaths, StaticWithWheelsNoHeading) {
   EXPECT_LT(o.eskf.rmse_h, 0.15);
   EXPECT_LT(o.smoother.rmse_h, 0.15);
   EXPECT_LT(o.eskf.rmse_yaw_deg, 1.0);
+}
+
+// A start at rest without a heading: every output from the first fix (README "Initialisation"). At rest the
+// forward streams hold the standstill's position, a zero velocity and an unknown yaw, the two-sided streams
+// the yaw found later (within 4 of their σ); from the standstill's end to the initialisation, the fit's
+// window. Every state before the initialisation lies within 3 of its σ of the truth (95 % of them).
+void ExpectOutputFromTheFirstFix(const SimOptions& sim, const EstimatorOptions& options, const char* name) {
+  const test::DriveRun run = test::RunDriveThroughSession(sim, options, nullptr, true, true, true);
+  ASSERT_TRUE(run.initialized) << name;
+  EXPECT_GT(run.stats["rest_states_before_initialization"].get<uint64_t>(), 0u) << name;
+  const double static_end = run.stats["initialization"]["static_end"].get<double>();
+  EXPECT_GT(static_end, run.first_t + 10.0) << name;
+  const double from = run.first_t + 1.0;  // the first fix comes within a second
+  const std::pair<const char*, const std::vector<StateEstimate>*> streams[] = {
+      {"eskf", &run.eskf}, {"smoother", &run.smoother}, {"eskf_rts", &run.eskf_rts}, {"batch", &run.batch}};
+  for (const auto& [stream, states] : streams) {
+    const double coverage = test::Coverage(run, *states, from);
+    size_t before = 0, within = 0, rest = 0;
+    double max_yaw_z = 0.0, max_h = 0.0;
+    const bool two_sided = states == &run.eskf_rts || states == &run.batch;
+    test::ForEachAtTruth(run, *states, from, run.init_t, [&](const StateEstimate& s, size_t j) {
+      const NavState& truth = run.truth[j];
+      const Vec3 d = s.x.p_wb - truth.p_wb;
+      ++before;
+      within += std::abs(d.x()) <= 3.0 * s.sigma_p.x() && std::abs(d.y()) <= 3.0 * s.sigma_p.y() &&
+                std::abs(d.z()) <= 3.0 * s.sigma_p.z();
+      max_h = std::max(max_h, d.head<2>().norm());
+      if (s.x.t >= static_end) return;
+      ++rest;
+      EXPECT_EQ(s.x.v_w, Vec3::Zero()) << name << " " << stream << " t=" << s.x.t;
+      const double yaw_error = WrapAngle(YawOfXAxis<double>(s.x.R_wb()) - YawOfXAxis<double>(truth.R_wb()));
+      if (two_sided) {
+        max_yaw_z = std::max(max_yaw_z, std::abs(yaw_error) / s.sigma_att.z());
+      } else {
+        EXPECT_EQ(s.sigma_att.z(), kUnknownYawSigma) << name << " " << stream;
+      }
+    });
+    std::printf("[ %-34s] %-8s coverage %.4f, %zu states before init (%zu at rest), %zu within 3 σ, max %.3f m, "
+                "rest yaw error/σ %.2f\n",
+                name, stream, coverage, before, rest, within, max_h, max_yaw_z);
+    EXPECT_GE(coverage, 0.99) << name << " " << stream;
+    EXPECT_GT(rest, 0u) << name << " " << stream;
+    EXPECT_GE(within, 0.95 * static_cast<double>(before)) << name << " " << stream;
+    if (two_sided) {
+      EXPECT_LT(max_yaw_z, 4.0) << name << " " << stream;
+    }
+  }
+}
+
+TEST(InitializationPaths, AtRestWithoutHeadingEveryOutputFromTheFirstFix) {
+  SimOptions sim = test::TestDrive(31);
+  sim.heading_invalid_fraction = 1.0;
+  EstimatorOptions options = test::TestRunOptions(sim);
+  options.gnss.use_heading = false;
+  ExpectOutputFromTheFirstFix(sim, options, "rest, wheels, no heading");
+  const SimOptions spp = SppDrive(32, 5.0);
+  ExpectOutputFromTheFirstFix(spp, SppOptions(spp), "rest, no wheels, SPP 5 Hz");
 }
 
 // Static without wheels, single-point GNSS with Doppler velocity: the GNSS velocity witnesses the standstill.
@@ -220,10 +289,11 @@ TEST(InitializationPaths, CruiseIsNotAStandstill) {
   EXPECT_EQ(init["start"], "moving");
   EXPECT_EQ(o.run.stats["standstill_updates"].get<uint64_t>(), 0u);
   ExpectCovered(o);
-  ASSERT_FALSE(o.run.eskf.empty());
+  const StateEstimate* at_init = StateAt(o.run.eskf, o.run.init_t);
+  ASSERT_NE(at_init, nullptr);
   for (size_t i = 0; i < o.run.truth_t.size(); ++i) {
     if (std::abs(o.run.truth_t[i] - o.run.init_t) < 1e-6) {
-      EXPECT_LT((o.run.eskf.front().x.v_w - o.run.truth[i].v_w).norm(), 0.5);
+      EXPECT_LT((at_init->x.v_w - o.run.truth[i].v_w).norm(), 0.5);
     }
   }
 }

@@ -105,6 +105,7 @@ struct DriveOutput {
   nlohmann::json smoother_stats;
   double init_time = 0.0;
   size_t imu_after_init = 0;
+  size_t rest_states = 0;  // written before the initialisation (solver/pre_init_output.h)
   std::vector<double> outlier_times;  // fixes the simulator displaced
 };
 
@@ -136,6 +137,7 @@ DriveOutput RunDrive(const SimOptions& sim, const Options& options, bool with_es
   session.Finish();
   out.smoother_stats = smoother->Stats();
   out.init_time = session.init_result().x0.t;
+  out.rest_states = session.Stats()["rest_states_before_initialization"].get<size_t>();
   return out;
 }
 
@@ -160,14 +162,17 @@ TEST(SmootherEndToEnd, SimulatedDriveAccuracyOnlineStreamAndNoWorseThanEskf) {
     Print("smoother final", seed, s);
     Print("eskf", seed, e);
 
-    // The final stream: every IMU sample after initialisation once (plus the first keyframe at the
-    // initialisation epoch, whose IMU sample preceded the completing fix), time-ordered, finite.
+    // The final stream: the states at rest before the initialisation, then every IMU sample after it once
+    // (plus the first keyframe at the initialisation epoch, whose IMU sample preceded the completing fix),
+    // time-ordered, finite.
     EXPECT_EQ(s.non_finite, 0u);
     EXPECT_TRUE(s.time_ordered);
     EXPECT_EQ(s.unmatched, 0u);
-    EXPECT_NEAR(static_cast<double>(s.states), static_cast<double>(out.imu_after_init), 1.0);
-    ASSERT_FALSE(out.smoother_final.empty());
-    EXPECT_DOUBLE_EQ(out.smoother_final.front().x.t, out.init_time);
+    EXPECT_GT(out.rest_states, 0u);
+    EXPECT_NEAR(static_cast<double>(s.states), static_cast<double>(out.imu_after_init + out.rest_states), 1.0);
+    ASSERT_GT(out.smoother_final.size(), out.rest_states);
+    EXPECT_LT(out.smoother_final[out.rest_states - 1].x.t, out.init_time);
+    EXPECT_DOUBLE_EQ(out.smoother_final[out.rest_states].x.t, out.init_time);
     EXPECT_NEAR(out.smoother_final.back().x.t, out.truth.t.back(), 1e-3);
 
     EXPECT_LT(s.rmse_h, 0.02);
@@ -189,9 +194,9 @@ TEST(SmootherEndToEnd, SimulatedDriveAccuracyOnlineStreamAndNoWorseThanEskf) {
     EXPECT_GE(keyframes, 200u);
     EXPECT_GE(solves, keyframes - 1);
     EXPECT_EQ(out.smoother_stats["solver_failures"].get<uint64_t>(), 0u);
-    EXPECT_EQ(out.smoother_online.size(), solves + 1);
-    ASSERT_FALSE(out.smoother_online.empty());
-    EXPECT_DOUBLE_EQ(out.smoother_online.front().x.t, out.init_time);
+    EXPECT_EQ(out.smoother_online.size(), out.rest_states + solves + 1);
+    ASSERT_GT(out.smoother_online.size(), out.rest_states);
+    EXPECT_DOUBLE_EQ(out.smoother_online[out.rest_states].x.t, out.init_time);
     const Metrics o = Evaluate(sim, out.truth, out.smoother_online);
     Print("smoother online", seed, o);
     EXPECT_EQ(o.non_finite, 0u);

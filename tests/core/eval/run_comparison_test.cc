@@ -162,7 +162,7 @@ TEST(CompareRunOutputs, AccuracyIsTheComparisonAgainstTheTruth) {
     SCOPED_TRACE(name);
     EXPECT_EQ(MetricsToJson(accuracy.at(name), kT0), c["vs_truth"][name]);
     const nlohmann::json a = AccuracyToJson(&accuracy.at(name));
-    EXPECT_EQ(a.size(), 8u);
+    EXPECT_EQ(a.size(), 9u);
     for (const auto& [key, value] : a.items()) EXPECT_EQ(value, c["vs_truth"][name][key]) << key;
   }
   const TrajectoryMetrics& online = accuracy.at("smoother_online");

@@ -105,6 +105,35 @@ TEST(TrajectoryMetrics, RotationsGiveKnownAttitudeAndHeadingErrors) {
   EXPECT_NEAR(EvaluateTrajectory(a, false, b, false, NoOutages()).rmse_heading_deg, 2.0, 1e-6);
 }
 
+// An estimate without a yaw (at rest before the initialisation, its σ that of an unknown angle) counts for
+// position, not for attitude or heading; nor does an interpolation touching such a sample.
+TEST(TrajectoryMetrics, StatesWithoutAYawAreLeftOutOfAttitudeAndHeading) {
+  const auto ref = Drive(10.0, 0.5);
+  auto est = ref;
+  for (size_t k = 0; k < est.size(); ++k) {
+    est[k].p_w.x() += 0.1;
+    if (k < 4) {
+      est[k].q_wb = QuatFromYaw(1.0);  // an arbitrary yaw
+      est[k].yaw_known = false;
+    } else {
+      est[k].q_wb = est[k].q_wb * QuatFromYaw(2.0 * kDegToRad);
+    }
+  }
+  const TrajectoryMetrics m = EvaluateTrajectory(ref, true, est, true, NoOutages());
+  EXPECT_EQ(m.samples, ref.size());
+  EXPECT_EQ(m.attitude_samples, ref.size() - 4);
+  EXPECT_NEAR(m.rmse_h, 0.1, 1e-9);
+  EXPECT_NEAR(m.rmse_heading_deg, 2.0, 1e-6);
+  EXPECT_NEAR(m.max_heading_deg, 2.0, 1e-6);
+  // At reference times between the samples, those bracketed by an unknown yaw are left out too.
+  auto mid = ref;
+  for (auto& x : mid) x.t += 0.25;
+  mid.pop_back();
+  const TrajectoryMetrics i = EvaluateTrajectory(mid, true, est, true, NoOutages());
+  EXPECT_EQ(i.attitude_samples, i.samples - 4);
+  EXPECT_NEAR(i.rmse_heading_deg, 2.0, 1e-6);
+}
+
 TEST(TrajectoryMetrics, InterpolatesAtReferenceTimesAndSkipsGaps) {
   const auto ref = Drive(30.0, 0.125);  // straight: linear interpolation is exact
   // The estimate at 64 Hz, half a sample later than the reference's times, with a 2 s hole after 10 s.

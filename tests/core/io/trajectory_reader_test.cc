@@ -63,7 +63,24 @@ TEST(ReadTrajectory, ReadsWhatTheWritersWrite) {
     if (csv) {
       EXPECT_LT((t.samples[2].v_w - states[2].v_w).norm(), 1e-5);
     }
+    for (const TrajectorySample& s : t.samples) EXPECT_TRUE(s.yaw_known);
   }
+}
+
+// A state CSV's yaw σ of an unknown angle (a state at rest before the initialisation) reads as no yaw.
+TEST(ReadTrajectory, AnUnknownYawSigmaReadsAsNoYaw) {
+  const std::string dir = test::MakeTempDir("traj_reader_yaw");
+  {
+    StatesCsvWriter csv(dir + "/eskf_states.csv", "eskf", kOrigin);
+    const auto states = States();
+    csv.Add(states[0], Vec3::Constant(0.1), Vec3::Constant(0.2), Vec3(0.01, 0.01, kUnknownYawSigma), 1.0);
+    csv.Add(states[1], Vec3::Constant(0.1), Vec3::Constant(0.2), Vec3(0.01, 0.01, 0.2), 1.0);
+    csv.Commit();
+  }
+  const Trajectory t = ReadTrajectory(dir + "/eskf_states.csv");
+  ASSERT_EQ(t.samples.size(), 2u);
+  EXPECT_FALSE(t.samples[0].yaw_known);
+  EXPECT_TRUE(t.samples[1].yaw_known);
 }
 
 void WriteGzip(const std::string& path, const std::string& text) {

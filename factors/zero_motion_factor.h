@@ -5,7 +5,8 @@
 //   r = [ (p_j − p_i) / σ_p ;  Log(q_iᵀ·q_j) / σ_θ ]     (unitless; σ_p in m, σ_θ in rad)
 // The rotation part is the zero-rotation constraint: with the IMU factor between the same keyframes it
 // observes the gyro bias (the preintegrated ΔR must be the identity). Together with the zero-velocity
-// factors it keeps a parked vehicle from wandering.
+// factors it keeps a parked vehicle from wandering. σ_θ = ∞ leaves the rotation free (a vehicle turning in
+// place: its rotation residual is then zero).
 #pragma once
 
 #include <ceres/cost_function.h>

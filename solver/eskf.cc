@@ -20,7 +20,6 @@ using eskf::BlockOf;
 
 namespace {
 
-constexpr double kZeroRateGateProbability = 0.9999;  // the gyro-reads-its-bias update at standstills
 
 }  // namespace
 

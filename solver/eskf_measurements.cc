@@ -212,7 +212,7 @@ void Eskf::AddStandstill(const StandstillMeasurement& m) {
             Mat3::Identity() * sv * sv, gate_zupt_, &zupt_counts_, m.t);
   if (rate_usable) {
     // Standing on the rotating Earth, the gyro reads its bias plus the Earth rate.
-    const double sigma = 2.0 * options_.imu.gyro_noise_density / std::sqrt(T);
+    const double sigma = ZeroRateSigma(options_.imu.gyro_noise_density, T);
     Update<3>(
         [&] {
           return Linearized<3>{Vec3(x_.bg + x_.q_wb.conjugate() * earth_.rate_w() - mean_gyro),

@@ -2,6 +2,7 @@
 // reader -> time-ordered measurement stream -> estimator -> state sink.
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <map>
 #include <optional>
@@ -118,6 +119,14 @@ constexpr double kImuGapTiltDensity = 0.5 * kDegToRad;    // rad per √s
 inline bool StandstillPlausible(const Vec3& v_w, const StandstillOptions& options) {
   return !(v_w.norm() > options.max_speed);
 }
+
+// At a standstill the gyro reads its bias plus the Earth's rate (the zero-rate check, alike in both
+// estimators): the residual bg + R_wbᵀ·ω_ie − the mean gyro reading over T seconds, 1-σ 2·N_g/√T per axis
+// (N_g: imu.gyro_noise), gated at this probability with the bias's σ. Standing is not the same as not
+// turning: a vehicle may turn in place, or settle for seconds after it stops; the gate then keeps its
+// rotation free (the translation still stands).
+constexpr double kZeroRateGateProbability = 0.9999;
+inline double ZeroRateSigma(double gyro_noise_density, double T) { return 2.0 * gyro_noise_density / std::sqrt(T); }
 
 // When the state is no longer finite nothing is left to keep: a level attitude (the yaw of the dual-antenna
 // heading if the fix has one) and zero biases, with this covariance in NavState tangent order: attitude

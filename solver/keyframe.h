@@ -131,7 +131,9 @@ struct Keyframe {
   std::vector<HeldImuSample> steps_from_prev;    // for the IMU-rate output between keyframes
   ceres::ResidualBlockId imu_id = nullptr;       // the IMU factor from the previous keyframe
   size_t imu_log_index = 0;                      // and its entry in the factor log, when one is kept
-  bool still_from_prev = false;  // stood still since the previous keyframe (a zero-motion factor joins them)
+  // Stood still since the previous keyframe, turning neither (a zero-motion factor with its rotation joins
+  // them): the outputs between them hold still.
+  bool still_from_prev = false;
 
   double* block(BlockType type) { return values + AmbientOffset(type); }
   const double* block(BlockType type) const { return values + AmbientOffset(type); }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "core/chi2.h"
@@ -202,7 +203,9 @@ bool GvelAttacher::OnGvel(const GvelMeasurement& m, const AttachContext& ctx) {
 // --- Standstill -------------------------------------------------------------------------------------------
 
 StandstillAttacher::StandstillAttacher(const EstimatorOptions& options)
-    : options_(options), gate_(Chi2Gate(options.wheel.gate_probability, 3)) {}  // standstill.* has no gate
+    : options_(options),
+      gate_(Chi2Gate(options.wheel.gate_probability, 3)),  // standstill.* has no gate
+      gate_zero_rate_(Chi2Gate(kZeroRateGateProbability, 3)) {}
 
 void StandstillAttacher::OnStandstill(const StandstillMeasurement& m, const AttachContext& ctx) {
   last_ = m;
@@ -232,16 +235,40 @@ void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
                           {{&kf, BlockType::kVelocity}});
   ++counts_.used;
   standing_[kf.id] = s.since;
-  // Two keyframes of one standstill: no translation, no rotation in between (its 0.1 mm would put any IMU
-  // disagreement in the flat part of a robust loss, so only between accepted zero velocities).
+  // Two keyframes of one standstill: no translation, and no rotation where the gyro agrees (its 0.1 mm
+  // would put any IMU disagreement in the flat part of a robust loss, so only between accepted zero
+  // velocities).
   if (ctx.keyframes.size() < 2) return;
   Keyframe& prev = ctx.keyframes[ctx.keyframes.size() - 2];
-  if (standing_.count(prev.id) == 0 || prev.t < s.since || kf.still_from_prev) return;
-  const double sigma_theta = std::max(2.0 * options_.imu.gyro_noise_density * std::sqrt(kf.t - prev.t), 1e-6);
+  if (standing_.count(prev.id) == 0 || prev.t < s.since) return;  // (kf's zero velocity is new: joined once)
+  // The rotation stands only where the gyro agrees (estimator.h, kZeroRateGateProbability): its mean over
+  // the interval, less the bias and the Earth's rate, within its noise and the bias's σ.
+  Vec3 integral = Vec3::Zero();
+  double span = 0.0;
+  for (const HeldImuSample& step : kf.steps_from_prev) {
+    integral += step.sample.gyro * step.dt;
+    span += step.dt;
+  }
+  bool turning = true;
+  if (span > 0.0) {
+    const double sigma = ZeroRateSigma(options_.imu.gyro_noise_density, span);
+    const Vec3 r = pred.x.bg + pred.x.q_wb.conjugate() * ctx.earth.rate_w() - integral / span;
+    const Mat3 S = SubCovariance(ctx.keyframes.EstimatedTypes(), pred.cov, {BlockType::kBias}).topLeftCorner<3, 3>() +
+                   sigma * sigma * Mat3::Identity();
+    const double chi2 = r.dot(S.ldlt().solve(r));
+    turning = !(chi2 <= gate_zero_rate_);
+  }
+  if (turning) {
+    zero_rotation_.Reject("chi2_gate", kf.t);
+  } else {
+    ++zero_rotation_.used;
+  }
+  const double sigma_theta = turning ? std::numeric_limits<double>::infinity()
+                                     : std::max(2.0 * options_.imu.gyro_noise_density * std::sqrt(kf.t - prev.t), 1e-6);
   ++zero_motion_factors_;
   ctx.keyframes.AddFactor(ZeroMotionFactor::Create(kStandstillPositionSigma, sigma_theta), nullptr,
                           {{&prev, BlockType::kPose}, {&kf, BlockType::kPose}});
-  kf.still_from_prev = true;
+  kf.still_from_prev = !turning;  // the outputs between them hold still (zero velocity, no IMU wobble)
 }
 
 void StandstillAttacher::OnWindowRebuilt() {
@@ -252,6 +279,7 @@ void StandstillAttacher::OnWindowRebuilt() {
 void StandstillAttacher::AddStats(nlohmann::json* stats) const {
   (*stats)["zero_velocity"] = counts_.ToJson();
   (*stats)["zero_motion_factors"] = zero_motion_factors_;
+  (*stats)["zero_rotation"] = zero_rotation_.ToJson();
 }
 
 }  // namespace gins

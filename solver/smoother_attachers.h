@@ -165,11 +165,13 @@ class StandstillAttacher final : public MeasurementAttacher {
   void Attach(Keyframe& kf, const AttachContext& ctx);
 
   EstimatorOptions options_;
-  double gate_;  // χ² gate on the zero velocity (3 dof)
+  double gate_;            // χ² gate on the zero velocity (3 dof)
+  double gate_zero_rate_;  // and on the zero rotation (kZeroRateGateProbability, 3 dof)
   std::optional<StandstillMeasurement> last_;
   std::map<uint64_t, double> standing_;  // keyframes with an accepted zero velocity: the start of their stop
   MeasurementCounts counts_;
   uint64_t zero_motion_factors_ = 0;
+  MeasurementCounts zero_rotation_;  // the zero-motion factors' rotation part: held, or turning (not held)
 };
 
 }  // namespace gins

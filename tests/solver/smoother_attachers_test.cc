@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -42,6 +43,17 @@ class AttacherTest : public ::testing::Test {
     x.v_w = Vec3(speed, 0.0, 0.0);
     Keyframe& kf = store_.Push(store_.Make(t, x));
     return kf;
+  }
+  // IMU steps over `span` s at 100 Hz reading a rate `rate_z` about body z (no bias, no Earth rate here).
+  static std::vector<HeldImuSample> Steps(double rate_z, double span) {
+    std::vector<HeldImuSample> steps;
+    for (int k = 0; k < static_cast<int>(std::lround(span / 0.01)); ++k) {
+      HeldImuSample h;
+      h.sample.gyro = Vec3(0.0, 0.0, rate_z);
+      h.dt = 0.01;
+      steps.push_back(h);
+    }
+    return steps;
   }
   // The prediction stub: the newest keyframe, with a diagonal covariance of position σ_p.
   Prediction Predict(double /*t*/) {
@@ -145,6 +157,7 @@ TEST_F(AttacherTest, StandstillIsCheckedAgainstThePredictedVelocity) {
   standstill.OnStandstill({20.0, 18.0}, context_);
   EXPECT_EQ(Residuals(), 1);  // the zero velocity
   Keyframe& b = Push(20.5, 0.01);
+  b.steps_from_prev = Steps(0.0, 0.5);  // the gyro reads no rotation
   standstill.OnKeyframeCreated(b, context_);
   EXPECT_EQ(Residuals(), 1);  // the last detection (20.0) is too old for it
   standstill.OnStandstill({20.5, 18.0}, context_);
@@ -160,6 +173,25 @@ TEST_F(AttacherTest, StandstillIsCheckedAgainstThePredictedVelocity) {
   EXPECT_EQ(s["zero_velocity"]["used"], 2);
   EXPECT_EQ(s["zero_velocity"]["rejected"]["chi2_gate"], 1);
   EXPECT_EQ(s["zero_motion_factors"], 1);
+  EXPECT_EQ(s["zero_rotation"]["used"], 1);
+}
+
+// Standing but turning in place: the gyro reads 1.1 deg/s where the bias (σ 0.06 deg/s) and the noise over
+// 0.5 s (0.04 deg/s) allow far less. The zero motion joins the keyframes with its rotation free, and the
+// outputs between them are not held still.
+TEST_F(AttacherTest, StandingButTurningKeepsTheRotationFree) {
+  StandstillAttacher standstill(options_);
+  Push(20.0, 0.0);
+  standstill.OnStandstill({20.0, 18.0}, context_);
+  Keyframe& b = Push(20.5, 0.0);
+  b.steps_from_prev = Steps(0.02, 0.5);
+  standstill.OnStandstill({20.5, 18.0}, context_);
+  EXPECT_EQ(Residuals(), 3);  // two zero velocities and the zero motion
+  EXPECT_FALSE(b.still_from_prev);
+  const nlohmann::json s = Stats(standstill);
+  EXPECT_EQ(s["zero_motion_factors"], 1);
+  EXPECT_EQ(s["zero_rotation"]["rejected"]["chi2_gate"], 1);
+  EXPECT_EQ(s["zero_rotation"]["used"], 0);
 }
 
 WheelMeasurement Wheel(double t, double speed) {

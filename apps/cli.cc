@@ -72,6 +72,26 @@ void PrintComparison(const nlohmann::json& s) {
   }
 }
 
+// Each estimator's verdict (solver/health.h), one line each; a run that is not ok says so on stderr too.
+void PrintHealth(const nlohmann::json& s) {
+  if (!s.contains("health")) return;
+  for (const auto& [name, h] : s["health"].items()) {
+    std::string line = h["verdict"].get<std::string>();
+    for (size_t i = 0; i < h["reasons"].size(); ++i) line += (i == 0 ? ": " : "; ") + h["reasons"][i].get<std::string>();
+    std::printf("  health %-8s %s\n", name.c_str(), line.c_str());
+    if (h["verdict"] != "ok") std::fprintf(stderr, "gins: warning: %s is %s\n", name.c_str(), line.c_str());
+  }
+}
+
+// Whether every estimator's verdict is ok (for --strict).
+bool AllHealthy(const nlohmann::json& s) {
+  if (!s.contains("health")) return true;
+  for (const auto& [name, h] : s["health"].items()) {
+    if (h["verdict"] != "ok") return false;
+  }
+  return true;
+}
+
 void PrintRunReport(const RunRequest& req, const RunResult& r) {
   std::printf("gins: mode %s, log %s\n", req.mode.c_str(), req.log_path.c_str());
   const auto& s = r.summary;
@@ -88,6 +108,7 @@ void PrintRunReport(const RunRequest& req, const RunResult& r) {
               tm["log_duration_s"].get<double>(), tm["real_time_factor"].get<double>());
   for (const auto& f : r.outputs) std::printf("  wrote %s\n", f.c_str());
   PrintComparison(s);
+  PrintHealth(s);
 }
 
 }  // namespace
@@ -110,6 +131,9 @@ int RunCli(int argc, const char* const* argv) {
   run->add_option("--out", req.out_dir, "Output directory (created if missing)")->required();
   run->add_option("--mode", req.mode, "Estimator")->check(CLI::IsMember(SupportedModes()))->capture_default_str();
   run->add_option("--truth", truth_path, "Truth CSV (DESIGN §5) for an accuracy summary")->check(CLI::ExistingFile);
+  bool strict = false;
+  run->add_flag("--strict", strict,
+                "Exit 3 unless every estimator's health verdict is ok (degraded or failed: summary.json's health)");
 
   std::string sim_config, sim_out;
   auto* sim = app.add_subcommand("simulate", "Simulate a drive: writes log.txt and truth.csv");
@@ -150,6 +174,10 @@ int RunCli(int argc, const char* const* argv) {
       if (!truth_path.empty()) req.truth_path = truth_path;
       const RunResult result = Run(config, req);
       PrintRunReport(req, result);
+      if (strict && !AllHealthy(result.summary)) {
+        std::fprintf(stderr, "gins: --strict: an estimator is not healthy (summary.json: health)\n");
+        return 3;
+      }
       return 0;
     }
     if (*sim) {

@@ -19,6 +19,7 @@
 #include "core/io/read_ahead.h"
 #include "core/io/trajectory_writer.h"
 #include "core/io/truth_reader.h"
+#include "solver/health.h"
 
 namespace gins {
 namespace {
@@ -186,6 +187,15 @@ nlohmann::json RunSummary(const Options& options, const RunRequest& request, con
   if (request.truth_path) j["truth"] = *request.truth_path;
   j["gnss_lever_arm_m"] = {options.gnss.lever_b.x(), options.gnss.lever_b.y(), options.gnss.lever_b.z()};
   j["faults"] = FaultsJson(j, session_stats);
+  // Each estimator's verdict (solver/health.h), its outputs' dropped states included.
+  for (const auto& [name, est] : j["estimators"].items()) {
+    uint64_t non_finite = 0;
+    for (const auto& [stream, s] : streams) {
+      // eskf and eskf_rts are the ESKF's; smoother, smoother_online and batch the smoother's.
+      if ((stream.rfind("eskf", 0) == 0) == (name == "eskf")) non_finite += s->non_finite();
+    }
+    j["health"][name] = JudgeHealth(est, non_finite).ToJson();
+  }
   return j;
 }
 

@@ -310,6 +310,45 @@ TEST_F(CliRun, ImuDropoutRightAfterTheInitialisationRunsToTheEnd) {
   }
 }
 
+// The health verdict (solver/health.h): the drive as simulated is ok for both estimators and --strict exits 0;
+// with every fix from 10 s after the initialisation moved 30 m north (a receiver on the wrong datum) the run
+// still writes its outputs, the console and summary.json say the estimators are not ok, and --strict exits 3.
+TEST_F(CliRun, StrictExitsThreeUnlessEveryEstimatorIsHealthy) {
+  ASSERT_EQ(sim_exit_, 0);
+  const std::string clean = dir_ + "/out_strict_clean";
+  ASSERT_EQ(RunCliInChild({"run", "--config", config_, "--log", log_, "--out", clean, "--mode", "both", "--strict"}), 0);
+  const nlohmann::json ok = Summary(clean);
+  for (const char* name : {"eskf", "smoother"}) EXPECT_EQ(ok["health"][name]["verdict"], "ok") << ok["health"].dump();
+  const double t_init = ok["initialization"]["time"].get<double>();
+  std::string edited;
+  for (const std::string& line : Lines(test::ReadFile(log_))) {
+    std::istringstream in(line);
+    std::string kind;
+    double t = 0.0, lat = 0.0;
+    in >> kind >> t >> lat;
+    if (kind == "GNSS" && t > t_init + 10.0) {
+      std::string rest;
+      std::getline(in, rest);
+      char buf[64];
+      std::snprintf(buf, sizeof(buf), "%.10f", lat + 30.0 / 111111.0);
+      edited += "GNSS " + line.substr(5, line.find(' ', 5) - 5) + " " + buf + rest + "\n";
+      continue;
+    }
+    edited += line + "\n";
+  }
+  const std::string log = dir_ + "/log_moved.txt";
+  test::WriteFile(log, edited);
+  const std::string out = dir_ + "/out_strict_moved";
+  ASSERT_EQ(RunCliInChild({"run", "--config", config_, "--log", log, "--out", out, "--mode", "both"}), 0);
+  const nlohmann::json s = Summary(out);
+  std::printf("moved fixes: %s\n", s["health"].dump().c_str());
+  for (const char* name : {"eskf", "smoother"}) {
+    EXPECT_NE(s["health"][name]["verdict"], "ok") << name;
+    EXPECT_FALSE(s["health"][name]["reasons"].empty()) << name;
+  }
+  EXPECT_EQ(RunCliInChild({"run", "--config", config_, "--log", log, "--out", out, "--mode", "both", "--strict"}), 3);
+}
+
 TEST_F(CliRun, BadConfigKeyWritesNothing) {
   ASSERT_EQ(sim_exit_, 0);
   const std::string bad = dir_ + "/bad.yaml";

@@ -9,7 +9,7 @@
 // newline that does not parse, or a gzip stream cut short), time_jump.
 // Time: records must be non-decreasing in time over the whole file; records of different types may share
 // a time stamp in either order. A record older than the newest time read by more than
-// input.reorder_window_s (default 0) is out_of_order; younger ones pass, and the API's reorder buffer
+// input.reorder_window_s (default 0.1 s) is out_of_order; younger ones pass, and the API's reorder buffer
 // (gins/gins.h) sorts them into place by the same rule. A record of the same type with the same time stamp
 // as the previous one of that type is a duplicate. A record more than
 // input.max_time_jump_s ahead of the newest time read is a time_jump (a corrupted far-future time stamp
@@ -69,7 +69,7 @@ struct InputOptions {
   int max_line_length = 4096;        // input.max_line_length: characters; longer lines are damage
   double max_time_jump = 60.0;       // input.max_time_jump_s: a record this far ahead of the newest time is
                                      // damage (time_jump); 0 = no limit
-  double reorder_window = 0.0;       // input.reorder_window_s: a record this much older than the newest is
+  double reorder_window = 0.1;       // input.reorder_window_s: a record this much older than the newest is
                                      // sorted into place; older ones are out_of_order
   ImuRange imu_range;                // not an input.* key: the imu.* range (ReaderOptions)
 };

@@ -187,6 +187,7 @@ nlohmann::json RunSummary(const Options& options, const RunRequest& request, con
   if (request.truth_path) j["truth"] = *request.truth_path;
   j["gnss_lever_arm_m"] = {options.gnss.lever_b.x(), options.gnss.lever_b.y(), options.gnss.lever_b.z()};
   j["faults"] = FaultsJson(j, session_stats);
+  if (session_stats.contains("warnings")) j["warnings"] = session_stats["warnings"];
   // Each estimator's verdict (solver/health.h), its outputs' dropped states included.
   for (const auto& [name, est] : j["estimators"].items()) {
     uint64_t non_finite = 0;
@@ -310,7 +311,13 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
     ReadAhead<api::Record> records([&reader](api::Record* r) { return reader.Next(r); });
     api::Record rec;
     while (records.Next(&rec)) {
-      session.Push(rec);
+      try {
+        session.Push(rec);
+      } catch (const api::Error& e) {
+        // The IMU's units or axes (core/imu_checks.h): named with the log.
+        if (e.kind() == api::Error::Kind::kInput) throw RunError(request.log_path + ": " + e.what());
+        throw;
+      }
       CheckInitTimeout(request.log_path, options.init.max_wait, session);
     }
   }

@@ -1,5 +1,7 @@
 #include "solver/session.h"
 
+#include <glog/logging.h>
+
 #include <atomic>
 #include <cmath>
 #include <condition_variable>
@@ -192,6 +194,19 @@ void Session::AddImu(const ImuSample& raw) {
   ImuSample s = raw;
   s.gyro = options_.imu.R_b_imu * raw.gyro;
   s.acc = options_.imu.R_b_imu * raw.acc;
+  imu_check_.Add(s.acc);
+  switch (imu_check_.Judge(options_.vehicle.nonholonomic)) {
+    case ImuAxesAndUnitsCheck::Outcome::kRefuse:
+      throw RunError(imu_check_.message());
+    case ImuAxesAndUnitsCheck::Outcome::kWarn:
+      if (imu_warning_.empty()) {
+        imu_warning_ = imu_check_.message();
+        LOG(WARNING) << imu_warning_;
+      }
+      break;
+    default:
+      break;
+  }
   EnsureInitializer();
   if (!init_) {
     if (pending_imu_.size() < kMaxPending) {
@@ -404,6 +419,7 @@ nlohmann::json Session::Stats() const {
   j["dropped_before_first_fix"] = pending_dropped_;
   j["standstill_updates"] = standstill_sent_;
   j["rest_states_before_initialization"] = rest_sent_;
+  if (!imu_warning_.empty()) j["warnings"] = {imu_warning_};
   // Simulated outages as absolute [begin, end) windows, and the log's own GNSS gaps.
   nlohmann::json outages = nlohmann::json::array(), gaps = nlohmann::json::array();
   if (first_t_ >= 0.0) {

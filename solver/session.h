@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/geodesy.h"
+#include "core/imu_checks.h"
 #include "core/eval/gnss_outages.h"
 #include "core/measurements.h"
 #include "core/standstill_detector.h"
@@ -120,6 +121,10 @@ class Session {
   std::optional<RestState> rest_held_;
   double last_rest_t_ = -1e300;
   uint64_t rest_sent_ = 0;
+
+  // The IMU's units and axes from its first records (core/imu_checks.h): refused with the reason, or warned.
+  ImuAxesAndUnitsCheck imu_check_;
+  std::string imu_warning_;
 
   // Standstill detection (core/standstill_detector.h), fed from the initialiser's start; after
   // initialisation a StandstillMeasurement goes to every estimator every 0.1 s while the vehicle stands.

@@ -90,7 +90,11 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
 bool Session::Impl::Push(LogRecord record) {
   if (finished_) throw Error(Error::Kind::kUsage, "gins::api::Session: Push after Finish");
   if (CheckLogRecord(&record, &issue_, imu_range_) == LineParse::kDamaged) return Reject(record.type, issue_.reason);
-  if (!reorder_.Add(record, [this](const LogRecord& r) { Dispatch(r); })) return Reject(record.type, "late");
+  try {
+    if (!reorder_.Add(record, [this](const LogRecord& r) { Dispatch(r); })) return Reject(record.type, "late");
+  } catch (const RunError& e) {
+    throw Error(Error::Kind::kInput, e.what());  // the data cannot be used as they are (core/imu_checks.h)
+  }
   ++accepted_;
   RethrowCallbackError();
   return true;

@@ -431,6 +431,55 @@ TEST_F(CliRun, GarbageLogWritesNothing) {
 
 // A log that never initialises (init waits for a dual-antenna heading that never comes) fails after
 // reading the whole log: nothing written.
+// The IMU written in the wrong units or axes (core/imu_checks.h): the accelerometer in g, or forward-right-down
+// axes without imu.axes. Refused before any output, the message naming the log and the key or column to fix;
+// with imu.axes: FRD the same FRD log runs.
+TEST_F(CliRun, WrongImuUnitsOrAxesAreRefusedAndNamed) {
+  ASSERT_EQ(sim_exit_, 0);
+  std::string in_g, frd;
+  for (const std::string& line : Lines(test::ReadFile(log_))) {
+    if (line.rfind("IMU ", 0) != 0) {
+      in_g += line + "\n";
+      frd += line + "\n";
+      continue;
+    }
+    std::istringstream in(line);
+    std::string kind, t;
+    double g[3], a[3];
+    in >> kind >> t >> g[0] >> g[1] >> g[2] >> a[0] >> a[1] >> a[2];
+    char buf[256];
+    std::snprintf(buf, sizeof(buf), "IMU %s %.9e %.9e %.9e %.9e %.9e %.9e\n", t.c_str(), g[0], g[1], g[2],
+                  a[0] / 9.80665, a[1] / 9.80665, a[2] / 9.80665);
+    in_g += buf;
+    std::snprintf(buf, sizeof(buf), "IMU %s %.9e %.9e %.9e %.9e %.9e %.9e\n", t.c_str(), g[0], -g[1], -g[2], a[0],
+                  -a[1], -a[2]);
+    frd += buf;
+  }
+  const struct {
+    const char* name;
+    const std::string* text;
+    const char* cause;
+  } cases[] = {{"imu_in_g", &in_g, "are in g, not m/s² (multiply them by 9.80665)"},
+               {"imu_frd", &frd, "set imu.axes"}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string log = dir_ + "/" + c.name + ".txt", out = dir_ + "/out_" + c.name;
+    test::WriteFile(log, *c.text);
+    std::string err;
+    EXPECT_EQ(RunCliCapturingStderr({"run", "--config", config_, "--log", log, "--out", out, "--mode", "both"},
+                                    out + ".err", &err),
+              1);
+    EXPECT_NE(err.find("gins: error: " + log + ": "), std::string::npos) << err;
+    EXPECT_NE(err.find(c.cause), std::string::npos) << err;
+    EXPECT_EQ(FilesIn(out), 0u);
+  }
+  const std::string frd_config = dir_ + "/frd.yaml";
+  test::WriteFile(frd_config, test::ReadFile(config_) + "imu:\n  axes: FRD\n");
+  EXPECT_EQ(RunCliInChild({"run", "--config", frd_config, "--log", dir_ + "/imu_frd.txt", "--out", dir_ + "/out_frd_ok",
+                           "--mode", "eskf"}),
+            0);
+}
+
 TEST_F(CliRun, LogThatNeverInitialisesWritesNothing) {
   ASSERT_EQ(sim_exit_, 0);
   // The simulated log with every GNSS heading invalid while init waits for one (init.wait_for_heading).

@@ -45,7 +45,8 @@ class Error : public std::runtime_error {
  public:
   enum class Kind {
     kConfig,      // the config does not load (unknown key, bad value, unreadable file)
-    kInput,       // a log cannot be read, or is too damaged (input.on_error, input.max_errors)
+    kInput,       // a log cannot be read, or is too damaged (input.on_error, input.max_errors), or its IMU's
+                  // units or axes are wrong (the first records: the accelerometer in g, z pointing down)
     kNoSolution,  // Finish() without an initialisation (no standstill, no GNSS, ...)
     kUsage,       // the API called out of turn (e.g. Push after Finish)
   };
@@ -234,7 +235,8 @@ class Session {
 
   // True if the measurement was taken; false if refused, with the reason in status().rejections: a
   // value that is not finite or not plausible (the log reader's checks), or older than the newest
-  // measurement by more than input.reorder_window_s. Throws Error(kUsage) after Finish().
+  // measurement by more than input.reorder_window_s. Throws Error(kUsage) after Finish(), Error(kInput) when the
+  // first IMU records show wrong units or axes (the reason in what()).
   bool Push(const Imu& imu);
   bool Push(const Wheel& wheel);
   bool Push(const Gnss& fix);

@@ -1,0 +1,55 @@
+// The IMU's units and axes from its first samples (core/imu_checks.h): each verdict at its bound.
+#include "core/imu_checks.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+
+namespace gins {
+namespace {
+
+// kSamples of specific force `f` plus white noise σ (m/s²), then the verdict.
+ImuAxesAndUnitsCheck::Outcome Judge(const Vec3& f, bool land_vehicle, std::string* message = nullptr) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  ImuAxesAndUnitsCheck check;
+  for (size_t k = 0; k < ImuAxesAndUnitsCheck::kSamples; ++k) {
+    EXPECT_EQ(check.Judge(land_vehicle), ImuAxesAndUnitsCheck::Outcome::kPending);
+    check.Add(f + Vec3(noise(rng), noise(rng), noise(rng)));
+  }
+  const ImuAxesAndUnitsCheck::Outcome o = check.Judge(land_vehicle);
+  if (message) *message = check.message();
+  return o;
+}
+
+TEST(ImuAxesAndUnitsCheck, GravityUpOrTiltedOrAcceleratingIsOk) {
+  using O = ImuAxesAndUnitsCheck::Outcome;
+  EXPECT_EQ(Judge(Vec3(0.0, 0.0, 9.81), true), O::kOk);
+  EXPECT_EQ(Judge(Vec3(3.0, -2.0, 9.2), true), O::kOk);   // tilted 21°
+  EXPECT_EQ(Judge(Vec3(4.9, 0.0, 9.81), true), O::kOk);   // braking at 0.5 g
+  EXPECT_EQ(Judge(Vec3(0.0, 9.81, 0.5), true), O::kOk);   // mounted on its side: z not down
+}
+
+TEST(ImuAxesAndUnitsCheck, AccelerometerInGIsRefusedAndNamed) {
+  std::string m;
+  EXPECT_EQ(Judge(Vec3(0.0, 0.0, 1.0), true, &m), ImuAxesAndUnitsCheck::Outcome::kRefuse);
+  EXPECT_NE(m.find("in g, not m/s²"), std::string::npos) << m;
+  // Another unit, or the gyro in the accelerometer's columns: refused, not called g.
+  EXPECT_EQ(Judge(Vec3(0.0, 0.0, 981.0), false, &m), ImuAxesAndUnitsCheck::Outcome::kRefuse);
+  EXPECT_NE(m.find("another unit"), std::string::npos) << m;
+  EXPECT_EQ(Judge(Vec3(0.01, 0.0, 0.02), false, &m), ImuAxesAndUnitsCheck::Outcome::kRefuse);
+  EXPECT_EQ(m.find("in g,"), std::string::npos) << m;
+}
+
+TEST(ImuAxesAndUnitsCheck, ZDownIsRefusedForACarAndWarnedOtherwise) {
+  std::string m;
+  EXPECT_EQ(Judge(Vec3(0.0, 0.0, -9.81), true, &m), ImuAxesAndUnitsCheck::Outcome::kRefuse);
+  EXPECT_NE(m.find("imu.axes"), std::string::npos) << m;
+  EXPECT_EQ(Judge(Vec3(0.0, 0.0, -9.81), false, &m), ImuAxesAndUnitsCheck::Outcome::kWarn);
+  // Steep but not down: within half of g below the horizon is still a possible mount.
+  EXPECT_EQ(Judge(Vec3(8.0, 0.0, -4.5), true), ImuAxesAndUnitsCheck::Outcome::kOk);
+}
+
+}  // namespace
+}  // namespace gins

@@ -1,6 +1,7 @@
 #include "core/imu_checks.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace gins {
@@ -55,6 +56,88 @@ ImuAxesAndUnitsCheck::Outcome ImuAxesAndUnitsCheck::Judge(bool land_vehicle) {
     if (!land_vehicle) message_ += " (a vehicle that can be upside down: vehicle.nonholonomic is false, so it runs)";
   }
   return outcome_;
+}
+
+}  // namespace gins
+
+namespace gins {
+
+void TurnRateCheck::AddImu(double t, const Vec3& gyro_b, const Vec3& acc_b) {
+  if (outcome_ != Outcome::kPending || !gyro_b.allFinite() || !acc_b.allFinite()) return;
+  up_b_ = 0.99 * up_b_ + 0.01 * acc_b;  // about a second at 100 Hz: gravity, the accelerations averaged out
+  if (last_imu_t_ >= 0.0 && t > last_imu_t_ && t - last_imu_t_ < 1.0 && up_b_.norm() > 0.0) {
+    yaw_integral_ += gyro_b.dot(up_b_.normalized()) * (t - last_imu_t_);
+  }
+  last_imu_t_ = t;
+}
+
+void TurnRateCheck::AddFix(double t, const Vec3& p_w, double sigma_h) {
+  if (outcome_ != Outcome::kPending || !p_w.allFinite() || last_imu_t_ < 0.0) return;
+  const Fix f{t, yaw_integral_, p_w, sigma_h};
+  if (fixes_.empty()) {
+    fixes_.push_back(f);
+    return;
+  }
+  const Fix& a = fixes_.front();
+  const Vec3 d = f.p_w - a.p_w;
+  const double step = d.head<2>().norm();
+  if (t - a.t > 5.0) {  // too slow (or a gap) for a course: start again from here
+    fixes_ = {f};
+    have_course_ = false;
+    return;
+  }
+  if (step < std::max(kMinStep, 10.0 * std::max(a.sigma_h, sigma_h))) return;
+  const double course = std::atan2(d.y(), d.x());
+  const double mid_yaw = 0.5 * (a.yaw_integral + f.yaw_integral);
+  if (have_course_) {
+    const double dc = WrapAngle(course - course_), dg = mid_yaw - course_mid_yaw_;
+    if (std::abs(dc) < 0.5 * kPi) {
+      s_cg_ += dc * dg;
+      s_gg_ += dg * dg;
+      s_cc_ += dc * dc;
+      turned_ += std::abs(dg);  // the gyro's turning: the courses of metre-level fixes turn by their noise too
+      ++pairs_;
+    }
+  }
+  have_course_ = true;
+  course_ = course;
+  course_mid_yaw_ = mid_yaw;
+  fixes_ = {f};
+  if (turned_ >= kDecideTurn && pairs_ >= kMinPairs) Decide();
+}
+
+void TurnRateCheck::Decide() {
+  if (s_gg_ <= 0.0 || s_cc_ <= 0.0) return;
+  const double correlation = s_cg_ / std::sqrt(s_gg_ * s_cc_);
+  if (std::abs(correlation) < kMinCorrelation) return;  // the turns say too little yet
+  const double k = slope();
+  const auto near = [k](double want) { return std::abs(k / want - 1.0) < 0.25; };
+  if (near(1.0)) {
+    outcome_ = Outcome::kOk;
+    return;
+  }
+  outcome_ = Outcome::kRefuse;
+  char buf[512];
+  const bool mirrored = correlation < 0.0;  // a car's course cannot turn against its yaw
+  if (!mirrored && !near(kDegToRad)) {
+    // Neither of the two mistakes it can name: metre-level fixes' correlated errors bend short courses
+    // (a legitimate single-point drive gave 2.3), so nothing is refused on a guess; it keeps watching.
+    outcome_ = Outcome::kPending;
+    return;
+  }
+  if (mirrored) {
+    std::snprintf(buf, sizeof(buf),
+                  "the GNSS track turns the other way from the gyro (course change %.2f × the gyro's): latitude "
+                  "and longitude swapped in the GNSS records (columns t lat lon), or a mirrored gyro axis "
+                  "(imu.axes)",
+                  k);
+  } else {
+    std::snprintf(buf, sizeof(buf),
+                  "the gyro turns %.1f× more than the GNSS track: its columns (gx gy gz) are in deg/s, not rad/s "
+                  "(multiply them by 0.0174533)",
+                  1.0 / k);
+  }
+  message_ = buf;
 }
 
 }  // namespace gins

@@ -8,6 +8,7 @@
 //       others (a drone or a hand-held unit may start so).
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,58 @@ class ImuAxesAndUnitsCheck {
  private:
   std::vector<double> norm_, up_;
   bool judged_ = false;
+  Outcome outcome_ = Outcome::kPending;
+  std::string message_;
+};
+
+}  // namespace gins
+
+namespace gins {
+
+// The gyro's turning against the GNSS track's (README "Sanity checks"), for a car (vehicle.nonholonomic: it
+// drives along its body x, so its yaw turns with its course). Over successive fixes the course change Δc
+// (from the track between fixes at least kMinStep and 10 σ apart) is regressed on the gyro's integrated rate
+// about gravity Δg over the same time: Δc = k·Δg. Decided once the vehicle has turned kDecideTurn in all
+// by the gyro (its integral, not the courses, which turn by the fixes' noise too) over at least kMinPairs
+// course changes, with a correlation above kMinCorrelation in size:
+//   k ≈ 1 (within 25 %): ok;
+//   k < 0: the track turns the other way (latitude and longitude swapped, which also stretches it: about −1.5
+//          at 31° N, 60° E; or a mirrored gyro axis): refused;
+//   k ≈ 1/57.3: the gyro columns are in deg/s: refused;
+//   any other k: still watching (short courses of metre-level fixes bend: nothing is refused on a guess).
+class TurnRateCheck {
+ public:
+  static constexpr double kMinStep = 1.0;                 // m between the fixes a course comes from
+  static constexpr double kDecideTurn = 45.0 * kDegToRad;  // course turned in all before a verdict
+  static constexpr double kMinCorrelation = 0.9;
+  static constexpr int kMinPairs = 10;  // course changes before a verdict
+
+  enum class Outcome { kPending, kOk, kRefuse };
+
+  void AddImu(double t, const Vec3& gyro_b, const Vec3& acc_b);
+  // A fix: its position in w (east, north) and horizontal 1-σ (m).
+  void AddFix(double t, const Vec3& p_w, double sigma_h);
+  Outcome outcome() const { return outcome_; }
+  const std::string& message() const { return message_; }
+  double slope() const { return s_gg_ > 0.0 ? s_cg_ / s_gg_ : 0.0; }
+  double turned() const { return turned_; }  // rad the gyro turned over the course changes used so far
+  double correlation() const { return s_gg_ > 0.0 && s_cc_ > 0.0 ? s_cg_ / std::sqrt(s_gg_ * s_cc_) : 0.0; }
+
+ private:
+  void Decide();
+
+  Vec3 up_b_ = Vec3::Zero();  // running mean of the specific force: gravity's direction in b
+  double last_imu_t_ = -1.0, yaw_integral_ = 0.0;
+  struct Fix {
+    double t, yaw_integral;
+    Vec3 p_w;
+    double sigma_h;
+  };
+  std::vector<Fix> fixes_;  // the anchor fix of the current course and the newest
+  bool have_course_ = false;
+  double course_ = 0.0, course_mid_yaw_ = 0.0;
+  double s_cg_ = 0.0, s_gg_ = 0.0, s_cc_ = 0.0, turned_ = 0.0;
+  int pairs_ = 0;
   Outcome outcome_ = Outcome::kPending;
   std::string message_;
 };

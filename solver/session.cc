@@ -207,6 +207,7 @@ void Session::AddImu(const ImuSample& raw) {
     default:
       break;
   }
+  if (options_.vehicle.nonholonomic) turn_check_.AddImu(s.t, s.gyro, s.acc);
   EnsureInitializer();
   if (!init_) {
     if (pending_imu_.size() < kMaxPending) {
@@ -350,6 +351,10 @@ void Session::AddGnss(const GnssRecord& g) {
                             : CompassDegToEnuYaw(g.heading_deg);
   m.sigma_yaw = options_.gnss.heading_sigma;
   if (standstill_) standstill_->AddGnss(m);
+  if (options_.vehicle.nonholonomic) {
+    turn_check_.AddFix(m.t, m.p_w, m.sigma_w.head<2>().norm() / std::sqrt(2.0));
+    if (turn_check_.outcome() == TurnRateCheck::Outcome::kRefuse) throw RunError(turn_check_.message());
+  }
   if (!initialized_) {
     init_->AddGnss(m);
     if (init_->done()) {
@@ -420,6 +425,13 @@ nlohmann::json Session::Stats() const {
   j["standstill_updates"] = standstill_sent_;
   j["rest_states_before_initialization"] = rest_sent_;
   if (!imu_warning_.empty()) j["warnings"] = {imu_warning_};
+  if (options_.vehicle.nonholonomic) {
+    const char* verdict = turn_check_.outcome() == TurnRateCheck::Outcome::kOk ? "ok" : "undecided";
+    j["turn_rate_check"] = {{"verdict", verdict},
+                            {"course_per_gyro", turn_check_.slope()},
+                            {"correlation", turn_check_.correlation()},
+                            {"turned_deg", turn_check_.turned() * kRadToDeg}};
+  }
   // Simulated outages as absolute [begin, end) windows, and the log's own GNSS gaps.
   nlohmann::json outages = nlohmann::json::array(), gaps = nlohmann::json::array();
   if (first_t_ >= 0.0) {

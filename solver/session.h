@@ -124,6 +124,7 @@ class Session {
 
   // The IMU's units and axes from its first records (core/imu_checks.h): refused with the reason, or warned.
   ImuAxesAndUnitsCheck imu_check_;
+  TurnRateCheck turn_check_;  // for a car (vehicle.nonholonomic): the gyro against the GNSS track's turns
   std::string imu_warning_;
 
   // Standstill detection (core/standstill_detector.h), fed from the initialiser's start; after

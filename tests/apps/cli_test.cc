@@ -431,8 +431,8 @@ TEST_F(CliRun, GarbageLogWritesNothing) {
 
 // A log that never initialises (init waits for a dual-antenna heading that never comes) fails after
 // reading the whole log: nothing written.
-// The IMU written in the wrong units or axes (core/imu_checks.h): the accelerometer in g, or forward-right-down
-// axes without imu.axes. Refused before any output, the message naming the log and the key or column to fix;
+// The IMU written in the wrong units or axes (core/imu_checks.h): the accelerometer in g, forward-right-down
+// axes without imu.axes, or the gyro in deg/s. Refused before any output, the message naming the log and the key or column to fix;
 // with imu.axes: FRD the same FRD log runs.
 TEST_F(CliRun, WrongImuUnitsOrAxesAreRefusedAndNamed) {
   ASSERT_EQ(sim_exit_, 0);
@@ -455,12 +455,31 @@ TEST_F(CliRun, WrongImuUnitsOrAxesAreRefusedAndNamed) {
                   -a[1], -a[2]);
     frd += buf;
   }
+  // And the gyro in deg/s: found once the car has turned (the drive's 60° turn), against the GNSS track.
+  std::string in_deg;
+  for (const std::string& line : Lines(test::ReadFile(log_))) {
+    std::istringstream in(line);
+    std::string kind, t;
+    double g[3];
+    in >> kind >> t >> g[0] >> g[1] >> g[2];
+    if (kind != "IMU") {
+      in_deg += line + "\n";
+      continue;
+    }
+    std::string rest;
+    std::getline(in, rest);
+    char buf[128];
+    std::snprintf(buf, sizeof(buf), "IMU %s %.9e %.9e %.9e", t.c_str(), g[0] * kRadToDeg, g[1] * kRadToDeg,
+                  g[2] * kRadToDeg);
+    in_deg += buf + rest + "\n";
+  }
   const struct {
     const char* name;
     const std::string* text;
     const char* cause;
   } cases[] = {{"imu_in_g", &in_g, "are in g, not m/s² (multiply them by 9.80665)"},
-               {"imu_frd", &frd, "set imu.axes"}};
+               {"imu_frd", &frd, "set imu.axes"},
+               {"gyro_in_deg_s", &in_deg, "(gx gy gz) are in deg/s, not rad/s"}};
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
     const std::string log = dir_ + "/" + c.name + ".txt", out = dir_ + "/out_" + c.name;

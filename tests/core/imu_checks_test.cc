@@ -1,8 +1,10 @@
-// The IMU's units and axes from its first samples (core/imu_checks.h): each verdict at its bound.
+// The IMU's units and axes from its first samples, and the gyro against the GNSS track's turns
+// (core/imu_checks.h): each verdict at its bound.
 #include "core/imu_checks.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <string>
 
@@ -49,6 +51,52 @@ TEST(ImuAxesAndUnitsCheck, ZDownIsRefusedForACarAndWarnedOtherwise) {
   EXPECT_EQ(Judge(Vec3(0.0, 0.0, -9.81), false, &m), ImuAxesAndUnitsCheck::Outcome::kWarn);
   // Steep but not down: within half of g below the horizon is still a possible mount.
   EXPECT_EQ(Judge(Vec3(8.0, 0.0, -4.5), true), ImuAxesAndUnitsCheck::Outcome::kOk);
+}
+
+}  // namespace
+}  // namespace gins
+
+namespace gins {
+namespace {
+
+// A car at 10 m/s on 1 Hz fixes (2 cm), level, turning at `rate` (rad/s, true) for 30 s after 10 s straight;
+// the gyro reads gyro_scale × the true rate; mirror: the track's north flipped (a mirrored track).
+TurnRateCheck::Outcome Drive(double rate, double gyro_scale, bool mirror, TurnRateCheck* check) {
+  double yaw = 0.0;
+  Vec3 p = Vec3::Zero();
+  for (int k = 0; k <= 4000; ++k) {
+    const double t = 0.01 * k;
+    const double w = t < 10.0 ? 0.0 : rate;
+    check->AddImu(t, Vec3(0.0, 0.0, gyro_scale * w), Vec3(0.0, 0.0, 9.81));
+    if (k % 100 == 0) check->AddFix(t, Vec3(p.x(), mirror ? -p.y() : p.y(), 0.0), 0.02);
+    yaw += w * 0.01;
+    p += 10.0 * 0.01 * Vec3(std::cos(yaw), std::sin(yaw), 0.0);
+  }
+  return check->outcome();
+}
+
+TEST(TurnRateCheck, ACarWhoseGyroAndTrackAgreeIsOk) {
+  TurnRateCheck check;
+  EXPECT_EQ(Drive(0.05, 1.0, false, &check), TurnRateCheck::Outcome::kOk);
+  EXPECT_NEAR(check.slope(), 1.0, 0.05);
+  // Driving straight says nothing: no verdict.
+  TurnRateCheck straight;
+  EXPECT_EQ(Drive(0.0, 1.0, false, &straight), TurnRateCheck::Outcome::kPending);
+}
+
+TEST(TurnRateCheck, GyroInDegreesPerSecondIsRefusedAndNamed) {
+  TurnRateCheck check;
+  EXPECT_EQ(Drive(0.05, kRadToDeg, false, &check), TurnRateCheck::Outcome::kRefuse);
+  EXPECT_NE(check.message().find("in deg/s"), std::string::npos) << check.message();
+}
+
+TEST(TurnRateCheck, AMirroredTrackIsRefusedAndNamed) {
+  TurnRateCheck check;
+  EXPECT_EQ(Drive(0.05, 1.0, true, &check), TurnRateCheck::Outcome::kRefuse);
+  EXPECT_NE(check.message().find("latitude and longitude swapped"), std::string::npos) << check.message();
+  // A gyro 2× off (another unit) is not a mistake the check can name: it keeps watching.
+  TurnRateCheck other;
+  EXPECT_EQ(Drive(0.05, 2.0, false, &other), TurnRateCheck::Outcome::kPending);
 }
 
 }  // namespace

@@ -120,7 +120,7 @@ int RunCli(int argc, const char* const* argv) {
 
   CLI::App app{"gins: GNSS/INS fusion (error-state Kalman filter and sliding-window smoother)"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "gins 0.1.0");
+  app.set_version_flag("--version", std::string("gins ") + api::Version());
 
   RunRequest req;
   std::string config_path;

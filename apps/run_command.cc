@@ -159,7 +159,7 @@ nlohmann::json RunSummary(const Options& options, const RunRequest& request, con
                           const api::Session& api_session, const Streams& streams, Clock::time_point wall_start) {
   const Session& session = api::internal::Access::session(api_session);
   nlohmann::json j;
-  j["gins_version"] = "0.1.0";
+  j["gins_version"] = api::Version();
   j["mode"] = request.mode;
   j["config"] = request.config_path;
   j["log"] = request.log_path;

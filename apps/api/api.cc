@@ -7,12 +7,13 @@
 
 #include "apps/api/access.h"
 #include "apps/api/convert.h"
+#include "apps/api/version.h"
 #include "config/config_loader.h"
 #include "gins/gins.h"
 
 namespace gins::api {
 
-const char* Version() { return "0.1.0"; }
+const char* Version() { return GINS_VERSION; }
 
 double Record::t() const {
   switch (type) {

@@ -37,7 +37,7 @@ namespace internal {
 class Access;  // gins's own tools (`gins run`) reach the session's internals through it
 }
 
-// "0.1.0"
+// The library's version, "major.minor.patch" (CMakeLists.txt's project()).
 const char* Version();
 
 // Every error the API reports. what() is one line naming the file, line or key and the reason.

@@ -398,7 +398,7 @@ TEST(ApiConfigTest, NamesAndAttitude) {
   EXPECT_EQ(mode, Mode::kSmoother);
   EXPECT_FALSE(ParseMode("kalman", &mode));
   EXPECT_STREQ(StreamName(Stream::kSmootherOnline), "smoother_online");
-  EXPECT_STREQ(Version(), "0.1.0");
+  EXPECT_STREQ(Version(), GINS_PROJECT_VERSION);
   State s;  // identity: body x along east
   EXPECT_NEAR(HeadingDeg(s), 90.0, 1e-12);
   const double c = std::cos(M_PI / 8), sn = std::sin(M_PI / 8);  // 45° about up: x to north-east

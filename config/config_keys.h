@@ -57,6 +57,7 @@ inline constexpr auto kGnssKeys = [](auto& v, GnssOptions& o) {
   v.Vector3("sigma_m", o.sigma_enu, "[east, north, up]", Positive());
   v.Number("min_sigma_m", o.min_sigma, kNoUnit, Positive());
   v.Number("error_correlation_s", o.error_correlation, kNoUnit, NonNegative());
+  v.Number("time_offset_s", o.time_offset, kNoUnit, Within(-5.0, 5.0));
   v.Number("heading_sigma_deg", o.heading_sigma, kDeg, Positive());
   v.Boolean("use_heading", o.use_heading);
   v.Number("gate_probability", o.gate_probability, kNoUnit, GateProbability());

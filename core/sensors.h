@@ -33,6 +33,9 @@ struct GnssOptions {
   double mount_yaw = 12.06 * kDegToRad;    // gnss.mount_yaw_deg: yaw of the antenna baseline frame G in b
   Vec3 sigma_enu = Vec3(0.05, 0.05, 0.10);  // gnss.sigma_m [e, n, u]: used when a fix carries no σ
   double min_sigma = 0.005;                // gnss.min_sigma_m: floor for logged σ (a zero σ is not trusted)
+  // gnss.time_offset_s: the GNSS records (fixes, headings, velocities) are stamped this much after the IMU
+  // time at which they were measured (a receiver's latency into the logger); gins takes t − offset.
+  double time_offset = 0.0;
   // gnss.error_correlation_s: correlation time τ of the fixes' errors; each σ is inflated by
   // √((1+ρ)/(1−ρ)), ρ = exp(−Δt/τ), Δt the spacing of the fixes (core/gnss_noise.h). 0: independent fixes.
   double error_correlation = 0.0;

@@ -64,7 +64,8 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
     : options_(options),
       session_options_(session_options),
       session_(options_),
-      reorder_(options_.input.reorder_window),
+      // GNSS records taken back by gnss.time_offset_s must still find their place among the IMU's.
+      reorder_(options_.input.reorder_window + std::abs(options_.gnss.time_offset)),
       imu_range_(ReaderOptions(options_).imu_range) {
   session_.SetParallel(session_options_.parallel);
   const Mode mode = session_options_.mode;
@@ -90,6 +91,9 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
 bool Session::Impl::Push(LogRecord record) {
   if (finished_) throw Error(Error::Kind::kUsage, "gins::api::Session: Push after Finish");
   if (CheckLogRecord(&record, &issue_, imu_range_) == LineParse::kDamaged) return Reject(record.type, issue_.reason);
+  // At the IMU time of their measurement (gnss.time_offset_s).
+  if (record.type == LogRecord::Type::kGnss) record.gnss.t -= options_.gnss.time_offset;
+  if (record.type == LogRecord::Type::kGvel) record.gvel.t -= options_.gnss.time_offset;
   try {
     if (!reorder_.Add(record, [this](const LogRecord& r) { Dispatch(r); })) return Reject(record.type, "late");
   } catch (const RunError& e) {

@@ -48,10 +48,10 @@ constexpr double kMaxSettledYawSigma = 30.0 * kDegToRad;
 // ... and roll and pitch 1-σ up to this: gravity observes them within seconds once the estimators run, and
 // at 3 σ (15°) the linearised gravity is off by 1 − cos 15° ≈ 3 % of g, which the iterated update absorbs.
 constexpr double kMaxSettledTiltSigma = 5.0 * kDegToRad;
-// Floors of the initial covariance (1-σ): the estimators invert it.
 // Gyrocompassing at rest gives a yaw when its 1-σ is at most this (rad); beyond, the linearised σ means
 // little and the yaw is taken as unknown.
 constexpr double kMaxGyrocompassSigma = 15.0 * kDegToRad;
+// Floors of the initial covariance (1-σ): the estimators invert it.
 constexpr double kFloorPos = 1e-3, kFloorVel = 1e-3, kFloorAtt = 1e-5, kFloorBg = 1e-7, kFloorBa = 1e-5;
 
 std::string Deg(double rad) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -396,13 +397,27 @@ void Initializer::RestStates(double after, std::vector<RestState>* out) const {
     }
   }
   r.x.q_wb = (QuatFromYaw(yaw) * q0).normalized();
-  // The antenna: the fixes' weighted mean (each σ already covers the fixes' correlation, gnss_noise.h).
+  // The antenna: the fixes' weighted mean (each σ already covers the fixes' correlation, gnss_noise.h),
+  // without the outliers: a fix whose offset from the fixes' median, over its σ, is beyond the fix gate's
+  // χ²(3) quantile (gnss.gate_probability) does not stand where the others do.
+  const std::vector<GnssMeasurement>& fixes = standing_->fixes;
+  Vec3 median;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> v;
+    for (const GnssMeasurement& f : fixes) v.push_back(f.p_w[k]);
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    median[k] = v[v.size() / 2];
+  }
+  const double gate = options_.gnss.gate_probability > 0.0 ? Chi2Quantile(options_.gnss.gate_probability, 3)
+                                                            : std::numeric_limits<double>::infinity();
   Vec3 info = Vec3::Zero(), sum = Vec3::Zero();
-  for (const GnssMeasurement& f : standing_->fixes) {
+  for (const GnssMeasurement& f : fixes) {
+    if (fixes.size() >= 3 && (f.p_w - median).cwiseQuotient(f.sigma_w).squaredNorm() > gate) continue;
     const Vec3 w = f.sigma_w.cwiseAbs2().cwiseInverse();
     info += w;
     sum += w.cwiseProduct(f.p_w);
   }
+  if (!(info.minCoeff() > 0.0)) return;
   const Vec3 p_antenna = sum.cwiseQuotient(info);
   // The IMU point: the lever arm's vertical part is known from the tilt; its horizontal part turns with the
   // yaw (for an unknown yaw a circle about the antenna: a mean of zero, a variance of half its squared

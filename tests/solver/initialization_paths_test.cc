@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -125,8 +126,16 @@ TEST(InitializationPaths, StaticWithWheelsNoHeading) {
 // forward streams hold the standstill's position, a zero velocity and an unknown yaw, the two-sided streams
 // the yaw found later (within 4 of their σ); from the standstill's end to the initialisation, the fit's
 // window. Every state before the initialisation lies within 3 of its σ of the truth (95 % of them).
-void ExpectOutputFromTheFirstFix(const SimOptions& sim, const EstimatorOptions& options, const char* name) {
-  const test::DriveRun run = test::RunDriveThroughSession(sim, options, nullptr, true, true, true);
+// outlier_t: the fix at that time moved 20 m north (none if 0).
+void ExpectOutputFromTheFirstFix(const SimOptions& sim, const EstimatorOptions& options, const char* name,
+                                 double outlier_t = 0.0) {
+  const test::RecordHook hook = [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, Session&) {
+    if (r.type != SimRecord::Type::kGnss || std::abs(r.gnss.t - outlier_t) > 1e-6) return feed(r);
+    SimRecord moved = r;
+    moved.gnss.lat_deg += 20.0 / 111111.0;
+    feed(moved);
+  };
+  const test::DriveRun run = test::RunDriveThroughSession(sim, options, hook, true, true, true);
   ASSERT_TRUE(run.initialized) << name;
   EXPECT_GT(run.stats["rest_states_before_initialization"].get<uint64_t>(), 0u) << name;
   const double static_end = run.stats["initialization"]["static_end"].get<double>();
@@ -174,6 +183,8 @@ TEST(InitializationPaths, AtRestWithoutHeadingEveryOutputFromTheFirstFix) {
   EstimatorOptions options = test::TestRunOptions(sim);
   options.gnss.use_heading = false;
   ExpectOutputFromTheFirstFix(sim, options, "rest, wheels, no heading");
+  // A gross outlier among the standstill's fixes (20 m north at 8 s) is not in its position.
+  ExpectOutputFromTheFirstFix(sim, options, "rest, wheels, no heading, an outlier", sim.start_time + 8.0);
   const SimOptions spp = SppDrive(32, 5.0);
   ExpectOutputFromTheFirstFix(spp, SppOptions(spp), "rest, no wheels, SPP 5 Hz");
 }

@@ -79,6 +79,12 @@ struct WheelMeasurement {
 struct StandstillMeasurement {
   double t = 0.0;
   double since = 0.0;
+  // False when nothing witnesses the stop (no wheels, no GNSS: an outage): only the quiet IMU and the
+  // estimate's own speed say so. Then acc_mean_b, the mean specific force over the detector's window
+  // (window_s), lets the estimator check it is not braking smoothly (an IMU as quiet as at rest).
+  bool witnessed = true;
+  Vec3 acc_mean_b = Vec3::Zero();
+  double window_s = 0.0;
 };
 
 }  // namespace gins

@@ -30,6 +30,12 @@ bool GnssShowsMotion(const GnssSpeed& s, double probability) {
   return s.v.squaredNorm() > Chi2Quantile(probability, 2) * s.sigma * s.sigma;
 }
 
+Vec3 StandstillDetector::WindowMeanAcc() const {
+  Vec3 sum = Vec3::Zero();
+  for (const ImuSample& s : imu_) sum += s.acc;
+  return imu_.empty() ? sum : Vec3(sum / static_cast<double>(imu_.size()));
+}
+
 const char* WitnessName(StandstillDetector::Witness w) {
   switch (w) {
     case StandstillDetector::Witness::kWheels:

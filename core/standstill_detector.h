@@ -64,6 +64,8 @@ class StandstillDetector {
   // What decided the last kStanding or kMoving (kNone: nothing could).
   Witness witness() const;
   bool WheelsPresent() const;
+  // The mean specific force over the window (body axes; zero without samples).
+  Vec3 WindowMeanAcc() const;
 
  private:
   bool WindowQuiet() const;

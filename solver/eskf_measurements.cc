@@ -206,6 +206,16 @@ void Eskf::AddStandstill(const StandstillMeasurement& m) {
     zupt_counts_.Reject("moving", m.t);  // a quiet IMU at speed: not a stop
     return;
   }
+  {
+    const StateEstimate e = Estimate();
+    const double sigma_tilt = e.sigma_att.head<2>().maxCoeff();
+    const double sigma_ba = std::sqrt(BlockOf<Block::kBa>(P_).diagonal().maxCoeff());
+    if (AcceleratingWithoutWitness(m, x_, earth_.Gravity(x_.p_wb) + dg_w_, sigma_tilt, sigma_ba,
+                                   options_.imu.acc_noise_density)) {
+      zupt_counts_.Reject("accelerating", m.t);  // braking smoothly, nothing to say it stopped
+      return;
+    }
+  }
   // Standing: zero velocity, and the gyro reads its bias (zero-rate update), so nothing wanders.
   const double sv = options_.standstill.velocity_sigma;
   Update<3>([&] { return Linearized<3>{x_.v_w, EmbedJacobian<3>({{Block::kV, Mat3::Identity()}})}; },

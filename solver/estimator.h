@@ -128,6 +128,22 @@ inline bool StandstillPlausible(const Vec3& v_w, const StandstillOptions& option
 constexpr double kZeroRateGateProbability = 0.9999;
 inline double ZeroRateSigma(double gyro_noise_density, double T) { return 2.0 * gyro_noise_density / std::sqrt(T); }
 
+// A standstill nothing witnesses (StandstillMeasurement::witnessed false: no wheels, no GNSS) is not taken
+// while the estimate accelerates: smooth braking is as quiet to an IMU as rest, and a zero velocity taken
+// a fraction of a second before the stop moves a long outage's position by metres through its correlation
+// with the velocity. The window's mean specific force, less the bias, rotated into w and with gravity
+// added, must be zero horizontally within 3 σ: the tilt's σ times g, the accelerometer bias's σ and the
+// noise of the window's mean.
+inline bool AcceleratingWithoutWitness(const StandstillMeasurement& m, const NavState& x, const Vec3& g_w,
+                                       double sigma_tilt, double sigma_ba, double acc_noise_density) {
+  if (m.witnessed || !(m.window_s > 0.0)) return false;
+  const Vec3 a_w = x.q_wb * (m.acc_mean_b - x.ba) + g_w;
+  const double g = g_w.norm();
+  const double var = g * g * sigma_tilt * sigma_tilt + sigma_ba * sigma_ba +
+                     acc_noise_density * acc_noise_density / m.window_s;
+  return a_w.head<2>().squaredNorm() > 9.0 * var;
+}
+
 // When the state is no longer finite nothing is left to keep: a level attitude (the yaw of the dual-antenna
 // heading if the fix has one) and zero biases, with this covariance in NavState tangent order: attitude
 // 1-σ 0.22 rad in roll and pitch and 1 rad in yaw, biases at their initial σ (imu.init_*_bias_sigma);

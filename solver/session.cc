@@ -270,7 +270,12 @@ void Session::DetectStandstill(double t) {
   if (t - last_standstill_sent_ < kInterval - 1e-9) return;
   last_standstill_sent_ = t;
   ++standstill_sent_;
-  const StandstillMeasurement m{t, standing_since_};
+  StandstillMeasurement m{t, standing_since_};
+  if (standstill_->Decide() == StandstillDetector::State::kQuietUnwitnessed) {
+    m.witnessed = false;
+    m.acc_mean_b = standstill_->WindowMeanAcc();
+    m.window_s = options_.standstill.window;
+  }
   Dispatch(&Estimator::AddStandstill, m);
 }
 

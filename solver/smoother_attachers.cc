@@ -221,6 +221,20 @@ void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
     counts_.Reject("moving", kf.t);  // a quiet IMU at speed: not a stop
     return;
   }
+  // Nothing witnesses the stop (an outage without wheels): not while the estimate brakes (estimator.h).
+  {
+    const std::vector<BlockType> types = ctx.keyframes.EstimatedTypes();
+    const MatX pose = SubCovariance(types, pred.cov, {BlockType::kPose});
+    const Mat3 R_wb = pred.x.R_wb();
+    const Mat3 att_w = R_wb * pose.block<3, 3>(pose::kTheta, pose::kTheta) * R_wb.transpose();
+    const double sigma_tilt = std::sqrt(std::max(att_w(0, 0), att_w(1, 1)));
+    const double sigma_ba = std::sqrt(SubCovariance(types, pred.cov, {BlockType::kBias}).diagonal().tail<3>().maxCoeff());
+    if (AcceleratingWithoutWitness(s, pred.x, ctx.earth.Gravity(pred.x.p_wb), sigma_tilt, sigma_ba,
+                                   options_.imu.acc_noise_density)) {
+      counts_.Reject("accelerating", kf.t);  // braking smoothly, nothing to say it stopped
+      return;
+    }
+  }
   // A quiet IMU during a smooth start or a constant acceleration can look like a stop: a zero velocity
   // the predicted velocity disagrees with is not taken.
   ZeroVelocityFactor check(options_.standstill.velocity_sigma);

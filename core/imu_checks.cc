@@ -21,7 +21,8 @@ std::string Format(const char* format, double a, double b) {
 }  // namespace
 
 void ImuAxesAndUnitsCheck::Add(const Vec3& acc_b) {
-  if (judged_ || norm_.size() >= kSamples || !acc_b.allFinite()) return;
+  // An all-zero reading is a sensor not yet running (some loggers write them at power-up), not a unit.
+  if (judged_ || norm_.size() >= kSamples || !acc_b.allFinite() || acc_b.isZero(0.0)) return;
   norm_.push_back(acc_b.norm());
   up_.push_back(acc_b.z());
 }

@@ -33,6 +33,15 @@ TEST(ImuAxesAndUnitsCheck, GravityUpOrTiltedOrAcceleratingIsOk) {
   EXPECT_EQ(Judge(Vec3(0.0, 9.81, 0.5), true), O::kOk);   // mounted on its side: z not down
 }
 
+// A logger's all-zero records at power-up are no evidence of a unit: the check waits for real readings.
+TEST(ImuAxesAndUnitsCheck, AllZeroRecordsAtPowerUpAreNotJudged) {
+  ImuAxesAndUnitsCheck check;
+  for (size_t k = 0; k < 3 * ImuAxesAndUnitsCheck::kSamples; ++k) check.Add(Vec3::Zero());
+  EXPECT_EQ(check.Judge(true), ImuAxesAndUnitsCheck::Outcome::kPending);
+  for (size_t k = 0; k < ImuAxesAndUnitsCheck::kSamples; ++k) check.Add(Vec3(0.0, 0.0, 9.81));
+  EXPECT_EQ(check.Judge(true), ImuAxesAndUnitsCheck::Outcome::kOk);
+}
+
 TEST(ImuAxesAndUnitsCheck, AccelerometerInGIsRefusedAndNamed) {
   std::string m;
   EXPECT_EQ(Judge(Vec3(0.0, 0.0, 1.0), true, &m), ImuAxesAndUnitsCheck::Outcome::kRefuse);

@@ -1,7 +1,9 @@
 // One decoded stream (stream_format.h) through a Session with both estimators, fed as `gins run` feeds a log
 // (and given up like it when initialisation takes longer than init.max_wait_s), and the estimators' promises
 // checked whatever the input:
-//   - nothing aborts or throws, except RunError from Finish when the run never initialised;
+//   - nothing aborts or throws, except RunError from Finish when the run never initialised, and RunError from
+//     a record the sanity checks refuse (core/imu_checks.h: wrong IMU units or axes), which ends the run as
+//     `gins run` ends it, writing nothing;
 //   - every state and σ of every output stream is finite, the quaternion a unit one;
 //   - σ > 0 on the streams that write their σ (the ESKF, the smoother's final states); σ ≥ 0 on the
 //     smoother's online stream, which writes none (zero: not computed);
@@ -73,6 +75,7 @@ struct StreamResult {
   size_t records = 0;
   bool initialized = false;
   size_t states = 0;    // over all output streams
+  std::string refused;  // the sanity checks' reason when they refused the input (not a failure)
 };
 
 inline StreamResult RunStream(const uint8_t* data, size_t size) {
@@ -97,19 +100,24 @@ inline StreamResult RunStream(const uint8_t* data, size_t size) {
     if (first_t < 0.0) first_t = r.t();
     newest_t = r.t();
     ++result.records;
-    switch (r.type) {
-      case LogRecord::Type::kImu:
-        session.AddImu(r.imu);
-        break;
-      case LogRecord::Type::kOdom:
-        session.AddOdom(r.odom);
-        break;
-      case LogRecord::Type::kGnss:
-        session.AddGnss(r.gnss);
-        break;
-      case LogRecord::Type::kGvel:
-        session.AddGvel(r.gvel);
-        break;
+    try {
+      switch (r.type) {
+        case LogRecord::Type::kImu:
+          session.AddImu(r.imu);
+          break;
+        case LogRecord::Type::kOdom:
+          session.AddOdom(r.odom);
+          break;
+        case LogRecord::Type::kGnss:
+          session.AddGnss(r.gnss);
+          break;
+        case LogRecord::Type::kGvel:
+          session.AddGvel(r.gvel);
+          break;
+      }
+    } catch (const RunError& e) {
+      result.refused = e.what();  // the sanity checks: gins run stops here, with the reason
+      return result;
     }
     // gins run gives up here (RunError) and writes nothing.
     if (!session.initialized() && session.elapsed() > options.init.max_wait) return result;

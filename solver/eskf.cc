@@ -48,27 +48,21 @@ void Eskf::AddRestState(const StateEstimate& s) { pre_init_.Add(s, on_rts_ != nu
 
 void Eskf::Initialize(const InitResult& init) {
   pre_init_.Start(init, on_state_);
-  x_ = init.x0;
+  nom_.x = init.x0;
   earth_ = init.earth;
-  dg_w_.setZero();
-  scale_ = 1.0;
+  nom_.additive = EskfNominal::Start();
   P_.setZero();
   pending_ = PendingCovariance();
   P_.topLeftCorner<nav::kDim, nav::kDim>() = init.P0;
-  if (options_.eskf.estimate_gravity) {
-    BlockOf<Block::kG>(P_).diagonal().setConstant(options_.eskf.gravity_sigma * options_.eskf.gravity_sigma);
-  }
-  if (options_.wheel.enabled && options_.wheel.estimate_scale) {
-    P_(eskf::kS, eskf::kS) = options_.wheel.scale_sigma * options_.wheel.scale_sigma;
-  }
+  SetAdditivePriors();
   last_imu_.reset();
-  last_sample_t_ = x_.t;
+  last_sample_t_ = nom_.x.t;
   gyro_sum_.setZero();
   gyro_count_ = 0;
-  gyro_sum_start_ = x_.t;
+  gyro_sum_start_ = nom_.x.t;
   wheel_gyro_sum_.setZero();
   wheel_gyro_count_ = 0;
-  last_nhc_t_ = x_.t;
+  last_nhc_t_ = nom_.x.t;
   gnss_inflation_.Accepted();
   watchdog_.Clear();
   initialized_ = true;
@@ -80,9 +74,9 @@ void Eskf::Initialize(const InitResult& init) {
 }
 
 void Eskf::Propagate(double t, const ImuSample* held) {
-  const double dt = t - x_.t;
+  const double dt = t - nom_.x.t;
   if (dt <= 0.0) return;
-  if (rts_) rts_->AfterUpdates(Nominal(), P_);  // the updates at x_.t are done
+  if (rts_) rts_->AfterUpdates(Nominal(), P_);  // the updates at nom_.x.t are done
   if (held == nullptr && last_imu_) held = &*last_imu_;
   // Across an IMU gap, coast: no rotation, no acceleration (the held sample says nothing about the gap). The
   // gap is judged from the newest sample, whatever the state's time, and a step no sample covers (a fix
@@ -90,12 +84,12 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   const bool gap = held == nullptr || t - last_sample_t_ > options_.imu.max_gap;
   const Vec3 g_w = gravity();
   const Vec3& rate_w = earth_.rate_w();
-  const Vec3 omega = gap ? Vec3(x_.q_wb.conjugate() * rate_w) : Vec3(held->gyro - x_.bg);
-  const Vec3 acc = gap ? Vec3(x_.q_wb.conjugate() * (2.0 * rate_w.cross(x_.v_w) - g_w)) : Vec3(held->acc - x_.ba);
+  const Vec3 omega = gap ? Vec3(nom_.x.q_wb.conjugate() * rate_w) : Vec3(held->gyro - nom_.x.bg);
+  const Vec3 acc = gap ? Vec3(nom_.x.q_wb.conjugate() * (2.0 * rate_w.cross(nom_.x.v_w) - g_w)) : Vec3(held->acc - nom_.x.ba);
   // The covariance steps per sample, or over intervals of several (FlushCovariance), never across a gap.
   const bool per_sample = gap || options_.eskf.covariance_interval <= 0.0;
   if (gap) FlushCovariance();
-  Kinematics k{x_.q_wb, x_.v_w, x_.p_wb};
+  Kinematics k{nom_.x.q_wb, nom_.x.v_w, nom_.x.p_wb};
   if (!per_sample && pending_.steps == 0) {
     pending_.start = k;
     pending_.g_w = g_w;
@@ -110,12 +104,12 @@ void Eskf::Propagate(double t, const ImuSample* held) {
     J.B.setZero();
     J.G.setZero();
   }
-  if (rts_) rts_->RecordStep(omega + x_.bg, acc + x_.ba, x_.t, dt);
-  a_w_ = (k.v - x_.v_w) / dt;
-  x_.q_wb = k.q;
-  x_.v_w = k.v;
-  x_.p_wb = k.p;
-  x_.t = t;
+  if (rts_) rts_->RecordStep(omega + nom_.x.bg, acc + nom_.x.ba, nom_.x.t, dt);
+  a_w_ = (k.v - nom_.x.v_w) / dt;
+  nom_.x.q_wb = k.q;
+  nom_.x.v_w = k.v;
+  nom_.x.p_wb = k.p;
+  nom_.x.t = t;
   ++imu_steps_;
   if (per_sample) {
     if (rts_) rts_->Compound(J);
@@ -167,7 +161,7 @@ void Eskf::CoastCovariance(double dt) {
   P_.block<3, 3>(nav::kV, nav::kV).diagonal().array() += qa * dt;
   const Vec3 q_w(kImuGapTiltDensity * kImuGapTiltDensity, kImuGapTiltDensity * kImuGapTiltDensity,
                  kImuGapYawDensity * kImuGapYawDensity);
-  const Mat3 R_bw = x_.R_wb().transpose();  // δθ is about the body axes
+  const Mat3 R_bw = nom_.x.R_wb().transpose();  // δθ is about the body axes
   P_.block<3, 3>(nav::kTheta, nav::kTheta) += R_bw * (q_w * dt).asDiagonal() * R_bw.transpose();
   AddRandomWalks(dt);
 }
@@ -195,6 +189,16 @@ void Eskf::PropagateCovariance(const ImuStepJacobians& J, double dt) {
   AddRandomWalks(dt);
 }
 
+void Eskf::SetAdditivePriors() {
+  // A block not estimated keeps a zero variance: no update moves it (its gain row is zero).
+  if (options_.eskf.estimate_gravity) {
+    BlockOf<Block::kG>(P_).diagonal().setConstant(options_.eskf.gravity_sigma * options_.eskf.gravity_sigma);
+  }
+  if (options_.wheel.enabled && options_.wheel.estimate_scale) {
+    P_(eskf::kS, eskf::kS) = options_.wheel.scale_sigma * options_.wheel.scale_sigma;
+  }
+}
+
 void Eskf::AddRandomWalks(double dt) {
   const double qbg = options_.imu.gyro_bias_rw * options_.imu.gyro_bias_rw * dt;
   const double qba = options_.imu.acc_bias_rw * options_.imu.acc_bias_rw * dt;
@@ -207,7 +211,7 @@ void Eskf::AddRandomWalks(double dt) {
 
 void Eskf::AddImu(const ImuSample& imu) {
   if (!initialized_) return;
-  if (imu.t < x_.t) return;  // samples before the initialisation epoch were used by the initialiser
+  if (imu.t < nom_.x.t) return;  // samples before the initialisation epoch were used by the initialiser
   // Before the first sample after the initialisation, its epoch is the newest sample (a dropout right after
   // it is a gap as any other).
   if (imu.t - last_sample_t_ > options_.imu.max_gap) imu_gaps_.Add(last_sample_t_, imu.t);
@@ -263,19 +267,17 @@ bool Eskf::Update(const Model<M>& model, const Eigen::Matrix<double, M, M>& R, d
   // The prior undoubted: the RTS gain P⁺Φᵀ(P⁻)⁻¹ needs P⁻ consistent with the chain before it (an
   // inflation that doubts both alike leaves the gain unchanged; one on P⁻ alone would cut it).
   if (rts_) rts_->BeforeUpdate(Nominal(), P_);
-  const NavState x0 = x_;
-  const Vec3 dg0 = dg_w_;
-  const double s0 = scale_;
+  const EskfNominal x0 = nom_;
   MatP Pi = P0;
   MatPM K = llt.solve(PHt.transpose()).transpose();
   VecP e = -K * lin.r;
   for (int it = 1;; ++it) {
-    MoveNominal(e);
+    nom_.PlusInPlace(e);
     // Converged when the step is below 1 % of the σ of every state.
     const bool small = (e.array().abs() <= 0.01 * Pi.diagonal().array().sqrt()).all();
     if (it >= options_.eskf.iterations || small) break;
     lin = model();
-    const VecP delta = NominalMinus(x0, dg0, s0);
+    const VecP delta = nom_.Minus(x0);
     const Mat3 Jr = RightJacobian(Vec3(eskf::SegmentOf<Block::kTheta>(delta)));
     Pi = P0;
     const Eigen::Matrix<double, 3, eskf::kDim> rows = Jr * eskf::RowsOf<Block::kTheta>(Pi);
@@ -297,20 +299,6 @@ bool Eskf::Update(const Model<M>& model, const Eigen::Matrix<double, M, M>& R, d
   ResetCovariance(e);
   ++counts->used;
   return true;
-}
-
-void Eskf::MoveNominal(const VecP& dx) {
-  x_ = x_.Boxplus(dx.head<nav::kDim>());
-  dg_w_ += eskf::SegmentOf<Block::kG>(dx);
-  scale_ += dx[eskf::kS];
-}
-
-Eskf::VecP Eskf::NominalMinus(const NavState& x, const Vec3& dg, double s) const {
-  VecP d = VecP::Zero();
-  d.head<nav::kDim>() = x_.Boxminus(x);
-  eskf::SegmentOf<Block::kG>(d) = dg_w_ - dg;
-  d[eskf::kS] = scale_ - s;
-  return d;
 }
 
 void Eskf::ResetCovariance(const VecP& dx) {
@@ -342,22 +330,18 @@ bool Eskf::WatchGnss(const GnssMeasurement& m, bool accepted) {
 void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
   FlushCovariance();
   if (rts_) rts_->AfterUpdates(Nominal(), P_);  // the chain before the re-initialisation ends here
-  const bool finite = x_.AllFinite() && P_.allFinite();
+  const bool finite = nom_.x.AllFinite() && P_.allFinite();
   if (!finite) {
-    x_.q_wb = FallbackAttitude(m, options_);
-    x_.bg.setZero();
-    x_.ba.setZero();
-    x_.v_w.setZero();
-    if (!dg_w_.allFinite()) dg_w_.setZero();
-    if (!std::isfinite(scale_)) scale_ = 1.0;
+    nom_.x.q_wb = FallbackAttitude(m, options_);
+    nom_.x.bg.setZero();
+    nom_.x.ba.setZero();
+    nom_.x.v_w.setZero();
+    nom_.ResetNonFinite();
     P_.setZero();
     P_.topLeftCorner<nav::kDim, nav::kDim>() = FallbackCovariance(options_);
-    if (options_.eskf.estimate_gravity) {
-      BlockOf<Block::kG>(P_).diagonal().setConstant(std::pow(options_.eskf.gravity_sigma, 2));
-    }
-    if (options_.wheel.enabled && options_.wheel.estimate_scale) P_(eskf::kS, eskf::kS) = std::pow(options_.wheel.scale_sigma, 2);
+    SetAdditivePriors();
   }
-  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &x_, P_, course_wait_.Take());
+  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &nom_.x, P_, course_wait_.Take());
   P_ = 0.5 * (P_ + P_.transpose());
   gyro_sum_.setZero();
   gyro_count_ = 0;
@@ -371,12 +355,12 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
 
 StateEstimate Eskf::Estimate() const {
   StateEstimate e;
-  e.x = x_;
+  e.x = nom_.x;
   e.sigma_p = BlockOf<Block::kP>(P_).diagonal().cwiseSqrt();
   e.sigma_v = BlockOf<Block::kV>(P_).diagonal().cwiseSqrt();
-  const Mat3 R = x_.R_wb();
+  const Mat3 R = nom_.x.R_wb();
   e.sigma_att = (R * BlockOf<Block::kTheta>(P_) * R.transpose()).diagonal().cwiseSqrt();
-  e.odom_scale = scale_;
+  e.odom_scale = nom_.Scalar<Block::kS>();
   return e;
 }
 
@@ -393,11 +377,11 @@ nlohmann::json Eskf::Stats() const {
   j["nonholonomic"] = nhc_counts_.ToJson();
   j["gnss_reacquired"] = gnss_inflation_.reacquired();
   j["zero_velocity"] = zupt_counts_.ToJson();
-  j["final_odom_scale"] = scale_;
+  j["final_odom_scale"] = nom_.Scalar<Block::kS>();
   const Vec3 g_w = gravity();
   j["final_gravity"] = {g_w.x(), g_w.y(), g_w.z()};
-  j["final_gyro_bias_deg_h"] = {x_.bg.x() * kRadToDeg * 3600, x_.bg.y() * kRadToDeg * 3600, x_.bg.z() * kRadToDeg * 3600};
-  j["final_acc_bias_m_s2"] = {x_.ba.x(), x_.ba.y(), x_.ba.z()};
+  j["final_gyro_bias_deg_h"] = {nom_.x.bg.x() * kRadToDeg * 3600, nom_.x.bg.y() * kRadToDeg * 3600, nom_.x.bg.z() * kRadToDeg * 3600};
+  j["final_acc_bias_m_s2"] = {nom_.x.ba.x(), nom_.x.ba.y(), nom_.x.ba.z()};
   if (rts_) j["rts"] = rts_->Stats();
   return j;
 }

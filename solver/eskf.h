@@ -67,19 +67,19 @@ class Eskf : public Estimator {
   void Finish() override;
   nlohmann::json Stats() const override;
 
-  const NavState& state() const { return x_; }
+  const NavState& state() const { return nom_.x; }
   // The covariance at the current time (a pending covariance interval is stepped first).
   const MatP& covariance() {
     FlushCovariance();
     return P_;
   }
   // Gravity in w at the current position: the Earth model's, plus the estimated correction (δg).
-  Vec3 gravity() const { return earth_.Gravity(x_.p_wb) + dg_w_; }
+  Vec3 gravity() const { return earth_.Gravity(nom_.x.p_wb) + nom_.Get<eskf::Block::kG>(); }
   // The body's rate against w (rad/s) from the last IMU sample: gyro less bias less the Earth rate.
   Vec3 BodyRate() const {
-    return last_imu_ ? Vec3(last_imu_->gyro - x_.bg - x_.q_wb.conjugate() * earth_.rate_w()) : Vec3::Zero();
+    return last_imu_ ? Vec3(last_imu_->gyro - nom_.x.bg - nom_.x.q_wb.conjugate() * earth_.rate_w()) : Vec3::Zero();
   }
-  double odom_scale() const { return scale_; }
+  double odom_scale() const { return nom_.Scalar<eskf::Block::kS>(); }
   StateEstimate Estimate() const;
 
  private:
@@ -93,7 +93,9 @@ class Eskf : public Estimator {
   void FlushCovariance();
   // The covariance over a step no IMU sample covers (an IMU gap): see kImuGapAccDensity.
   void CoastCovariance(double dt);
-  // The random walks of the driving and passive blocks over dt.
+  // The prior variances of the additive blocks (δg, s) that are estimated; and their random walks, with
+  // the biases', over dt.
+  void SetAdditivePriors();
   void AddRandomWalks(double dt);
   // A measurement model linearised at the filter's current nominal state: its residual r = h(x) − z and
   // full-width Jacobian (from the blocks it touches, eskf::EmbedJacobian).
@@ -112,11 +114,8 @@ class Eskf : public Estimator {
   bool Update(const Model<M>& model, const Eigen::Matrix<double, M, M>& R, double gate, MeasurementCounts* counts,
               double t, double inflation = 1.0, Eigen::Matrix<double, M, 1>* innovation_out = nullptr,
               Eigen::Matrix<double, M, M>* S_out = nullptr);
-  // The nominal state moved by δx (no covariance change), and the covariance's reset for a step δx.
-  void MoveNominal(const VecP& dx);
+  // The covariance's reset for a step δx of the nominal state.
   void ResetCovariance(const VecP& dx);
-  // The nominal state minus (x, dg, s): the error-state vector between them.
-  VecP NominalMinus(const NavState& x, const Vec3& dg, double s) const;
   // The measurement updates (eskf_measurements.cc).
   bool UpdateGnssPosition(const GnssMeasurement& m);
   void UpdateHeading(const GnssMeasurement& m);
@@ -127,7 +126,7 @@ class Eskf : public Estimator {
   bool WatchGnss(const GnssMeasurement& m, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
 
-  EskfNominal Nominal() const { return {x_, dg_w_, scale_}; }
+  const EskfNominal& Nominal() const { return nom_; }
 
   EstimatorOptions options_;
   StateCallback on_state_;
@@ -135,10 +134,8 @@ class Eskf : public Estimator {
   PreInitOutput pre_init_{BridgeNoise{options_.imu.gyro_noise_density, options_.imu.acc_noise_density}};
   std::unique_ptr<EskfRts> rts_;  // with on_rts_
   bool initialized_ = false;
-  NavState x_;
+  EskfNominal nom_;  // the nominal state: nom_.x the NavState, then δg, the odometer scale (eskf_state.h)
   EarthModel earth_;
-  Vec3 dg_w_ = Vec3::Zero();  // the estimated correction of the model's gravity
-  double scale_ = 1.0;
   MatP P_ = MatP::Identity();
   // The samples' steps since the covariance's last step (eskf.covariance_interval_s): P_ is as of their
   // start. Estimate() reports its σ from P_ as it is.

@@ -28,16 +28,16 @@ Eigen::Quaternion<T> Rotated(const NavState& x, const Eigen::Matrix<T, 3, 1>& d_
 }  // namespace
 
 void Eskf::AddGnss(const GnssMeasurement& m) {
-  if (!initialized_ || m.t < x_.t) return;
+  if (!initialized_ || m.t < nom_.x.t) return;
   Propagate(m.t);
   if (options_.watchdog.enabled) {
     FlushCovariance();
     const double max_sigma = options_.watchdog.max_position_sigma;
-    const bool finite = x_.AllFinite() && P_.allFinite() && dg_w_.allFinite() && std::isfinite(scale_);
+    const bool finite = nom_.AllFinite() && P_.allFinite();
     if (course_wait_.waiting() || !finite ||
         BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
       // A lost yaw waits for a later fix's course rather than being kept (ResetWaitsForCourse).
-      if (!(finite && course_wait_.Hold(m, &prev_fix_, options_, x_, P_))) {
+      if (!(finite && course_wait_.Hold(m, &prev_fix_, options_, nom_.x, P_))) {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
         prev_fix_ = m;
       }
@@ -59,8 +59,8 @@ bool Eskf::UpdateGnssPosition(const GnssMeasurement& m) {
     Linearize<3, 6>(
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
-          const Eigen::Matrix<T, 3, 1> p = x_.p_wb.cast<T>() + d.template head<3>();
-          return GnssPositionModel::Residual<T>(p, Rotated<T>(x_, d.template tail<3>()), options_.gnss.lever_b,
+          const Eigen::Matrix<T, 3, 1> p = nom_.x.p_wb.cast<T>() + d.template head<3>();
+          return GnssPositionModel::Residual<T>(p, Rotated<T>(nom_.x, d.template tail<3>()), options_.gnss.lever_b,
                                                 m.p_w);
         },
         &r, &H6);
@@ -88,7 +88,7 @@ void Eskf::UpdateHeading(const GnssMeasurement& m) {
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
           return Eigen::Matrix<T, 1, 1>(
-              HeadingModel::Residual<T>(Rotated<T>(x_, Eigen::Matrix<T, 3, 1>(d)), options_.gnss.mount_yaw, m.yaw_G));
+              HeadingModel::Residual<T>(Rotated<T>(nom_.x, Eigen::Matrix<T, 3, 1>(d)), options_.gnss.mount_yaw, m.yaw_G));
         },
         &r, &H3);
     return Linearized<1>{r, EmbedJacobian<1>({{Block::kTheta, H3}})};
@@ -97,7 +97,7 @@ void Eskf::UpdateHeading(const GnssMeasurement& m) {
 }
 
 void Eskf::AddGvel(const GvelMeasurement& m) {
-  if (!initialized_ || m.t < x_.t) return;
+  if (!initialized_ || m.t < nom_.x.t) return;
   Propagate(m.t);
   // The antenna's velocity includes the lever arm's turn: the body rate from the last IMU sample.
   const Vec3 omega_b = BodyRate();
@@ -107,8 +107,8 @@ void Eskf::AddGvel(const GvelMeasurement& m) {
     Linearize<3, 6>(
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
-          const Eigen::Matrix<T, 3, 1> v = x_.v_w.cast<T>() + d.template head<3>();
-          return GnssVelocityModel::Residual<T>(Rotated<T>(x_, d.template tail<3>()), v, omega_b,
+          const Eigen::Matrix<T, 3, 1> v = nom_.x.v_w.cast<T>() + d.template head<3>();
+          return GnssVelocityModel::Residual<T>(Rotated<T>(nom_.x, d.template tail<3>()), v, omega_b,
                                                 options_.gnss.lever_b, m.v_w);
         },
         &r, &H6);
@@ -118,7 +118,7 @@ void Eskf::AddGvel(const GvelMeasurement& m) {
 }
 
 void Eskf::AddWheel(const WheelMeasurement& m) {
-  if (!initialized_ || m.t < x_.t || !options_.wheel.enabled) return;
+  if (!initialized_ || m.t < nom_.x.t || !options_.wheel.enabled) return;
   Propagate(m.t);
   // At zero pulses this is a zero-speed measurement; the standstill updates (AddStandstill) come from the
   // session's detector, which also wants the IMU quiet.
@@ -135,15 +135,15 @@ void Eskf::UpdateWheelSpeed(const WheelMeasurement& m) {
   const Model<1> model = [&] {
     Eigen::Matrix<double, 1, 1> r;
     Eigen::Matrix<double, 1, 7> H7;  // (δv, δθ, δs)
-    const Vec3 v_mid = x_.v_w - a_w_ * (0.5 * m.interval);
-    const double s0 = scale_;
+    const Vec3 v_mid = nom_.x.v_w - a_w_ * (0.5 * m.interval);
+    const double s0 = nom_.Scalar<Block::kS>();
     Linearize<1, 7>(
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
           const Eigen::Matrix<T, 3, 1> v = v_mid.cast<T>() + d.template head<3>();
           const T s = T(s0) + d[6];
           return Eigen::Matrix<T, 1, 1>(AxleSpeedModel::Residual<T>(
-              Rotated<T>(x_, Eigen::Matrix<T, 3, 1>(d.template segment<3>(3))), v, s, omega_b,
+              Rotated<T>(nom_.x, Eigen::Matrix<T, 3, 1>(d.template segment<3>(3))), v, s, omega_b,
               options_.wheel.lever_b, m.speed));
         },
         &r, &H7);
@@ -161,15 +161,15 @@ void Eskf::UpdateWheelYawRate(const WheelMeasurement& m) {
   // over the same interval: it observes the gyro's z bias (and the scale, weakly).
   const Vec3 mean_gyro = wheel_gyro_sum_ / wheel_gyro_count_;
   const Model<1> model = [&] {
-    const double omega_z = (mean_gyro - x_.bg - x_.q_wb.conjugate() * earth_.rate_w()).z();
+    const double omega_z = (mean_gyro - nom_.x.bg - nom_.x.q_wb.conjugate() * earth_.rate_w()).z();
     Eigen::Matrix<double, 1, eskf::kDim> H = Eigen::Matrix<double, 1, eskf::kDim>::Zero();
-    H(0, eskf::Offset(Block::kBg) + 2) = -scale_;
+    H(0, eskf::Offset(Block::kBg) + 2) = -nom_.Scalar<Block::kS>();
     if (options_.wheel.estimate_scale) H(0, eskf::kS) = omega_z;
-    return Linearized<1>{Eigen::Matrix<double, 1, 1>(scale_ * omega_z - m.yaw_rate), H};
+    return Linearized<1>{Eigen::Matrix<double, 1, 1>(nom_.Scalar<Block::kS>() * omega_z - m.yaw_rate), H};
   };
   // The gyro's own noise over the interval adds to the wheels'.
   const double gyro_var = std::pow(options_.imu.gyro_noise_density, 2) / m.interval;
-  const double var = m.yaw_rate_sigma * m.yaw_rate_sigma + scale_ * scale_ * gyro_var;
+  const double var = m.yaw_rate_sigma * m.yaw_rate_sigma + nom_.Scalar<Block::kS>() * nom_.Scalar<Block::kS>() * gyro_var;
   Update<1>(model, Eigen::Matrix<double, 1, 1>(var), gate_wheel_yaw_, &wheel_yaw_counts_, m.t);
 }
 
@@ -181,8 +181,8 @@ void Eskf::UpdateNonHolonomic(double t) {
     Linearize<2, 6>(
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
-          const Eigen::Matrix<T, 3, 1> v = x_.v_w.cast<T>() + d.template head<3>();
-          return AxleNhcModel::Residual<T>(Rotated<T>(x_, Eigen::Matrix<T, 3, 1>(d.template tail<3>())), v, omega_b,
+          const Eigen::Matrix<T, 3, 1> v = nom_.x.v_w.cast<T>() + d.template head<3>();
+          return AxleNhcModel::Residual<T>(Rotated<T>(nom_.x, Eigen::Matrix<T, 3, 1>(d.template tail<3>())), v, omega_b,
                                            options_.wheel.lever_b);
         },
         &r, &H6);
@@ -193,7 +193,7 @@ void Eskf::UpdateNonHolonomic(double t) {
 }
 
 void Eskf::AddStandstill(const StandstillMeasurement& m) {
-  if (!initialized_ || m.t < x_.t) return;
+  if (!initialized_ || m.t < nom_.x.t) return;
   Propagate(m.t);
   // The gyro mean since the last update observes the bias only if the whole interval was standing.
   const bool rate_usable = gyro_count_ > 0 && gyro_sum_start_ >= m.since && m.t > gyro_sum_start_;
@@ -202,7 +202,7 @@ void Eskf::AddStandstill(const StandstillMeasurement& m) {
   gyro_sum_.setZero();
   gyro_count_ = 0;
   gyro_sum_start_ = m.t;
-  if (!StandstillPlausible(x_.v_w, options_.standstill)) {
+  if (!StandstillPlausible(nom_.x.v_w, options_.standstill)) {
     zupt_counts_.Reject("moving", m.t);  // a quiet IMU at speed: not a stop
     return;
   }
@@ -210,7 +210,7 @@ void Eskf::AddStandstill(const StandstillMeasurement& m) {
     const StateEstimate e = Estimate();
     const double sigma_tilt = e.sigma_att.head<2>().maxCoeff();
     const double sigma_ba = std::sqrt(BlockOf<Block::kBa>(P_).diagonal().maxCoeff());
-    if (AcceleratingWithoutWitness(m, x_, earth_.Gravity(x_.p_wb) + dg_w_, sigma_tilt, sigma_ba,
+    if (AcceleratingWithoutWitness(m, nom_.x, earth_.Gravity(nom_.x.p_wb) + nom_.Get<Block::kG>(), sigma_tilt, sigma_ba,
                                    options_.imu.acc_noise_density)) {
       zupt_counts_.Reject("accelerating", m.t);  // braking smoothly, nothing to say it stopped
       return;
@@ -218,14 +218,14 @@ void Eskf::AddStandstill(const StandstillMeasurement& m) {
   }
   // Standing: zero velocity, and the gyro reads its bias (zero-rate update), so nothing wanders.
   const double sv = options_.standstill.velocity_sigma;
-  Update<3>([&] { return Linearized<3>{x_.v_w, EmbedJacobian<3>({{Block::kV, Mat3::Identity()}})}; },
+  Update<3>([&] { return Linearized<3>{nom_.x.v_w, EmbedJacobian<3>({{Block::kV, Mat3::Identity()}})}; },
             Mat3::Identity() * sv * sv, gate_zupt_, &zupt_counts_, m.t);
   if (rate_usable) {
     // Standing on the rotating Earth, the gyro reads its bias plus the Earth rate.
     const double sigma = ZeroRateSigma(options_.imu.gyro_noise_density, T);
     Update<3>(
         [&] {
-          return Linearized<3>{Vec3(x_.bg + x_.q_wb.conjugate() * earth_.rate_w() - mean_gyro),
+          return Linearized<3>{Vec3(nom_.x.bg + nom_.x.q_wb.conjugate() * earth_.rate_w() - mean_gyro),
                                EmbedJacobian<3>({{Block::kBg, Mat3::Identity()}})};
         },
         Mat3::Identity() * sigma * sigma, gate_zero_rate_, &zupt_counts_, m.t);

@@ -17,32 +17,7 @@ constexpr int kN = eskf::kDim;
 constexpr int kA = eskf::kKinematicDim;
 constexpr int kB = eskf::kNonKinematicDim;
 constexpr int kD = eskf::kDrivingDim;
-constexpr int kNominalSize = 20;            // t-less NavState (16), δg (3), scale (1)
 constexpr int kTriangle = kN * (kN + 1) / 2;  // a symmetric matrix's upper triangle
-
-void PackNominal(const EskfNominal& n, double* out) {
-  const NavState& x = n.x;
-  Vec3::Map(out) = x.p_wb;
-  Vec3::Map(out + 3) = x.v_w;
-  out[6] = x.q_wb.w(), out[7] = x.q_wb.x(), out[8] = x.q_wb.y(), out[9] = x.q_wb.z();
-  Vec3::Map(out + 10) = x.bg;
-  Vec3::Map(out + 13) = x.ba;
-  Vec3::Map(out + 16) = n.dg_w;
-  out[19] = n.scale;
-}
-
-EskfNominal UnpackNominal(const double* in, double t) {
-  EskfNominal n;
-  n.x.t = t;
-  n.x.p_wb = Eigen::Map<const Vec3>(in);
-  n.x.v_w = Eigen::Map<const Vec3>(in + 3);
-  n.x.q_wb = Quat(in[6], in[7], in[8], in[9]);
-  n.x.bg = Eigen::Map<const Vec3>(in + 10);
-  n.x.ba = Eigen::Map<const Vec3>(in + 13);
-  n.dg_w = Eigen::Map<const Vec3>(in + 16);
-  n.scale = in[19];
-  return n;
-}
 
 template <typename M>
 void PackSymmetric(const M& P, double* out) {
@@ -60,23 +35,6 @@ void UnpackSymmetric(const double* in, M* P) {
   }
 }
 
-// b ⊟ a in the filter's error state.
-EskfRts::VecP Minus(const EskfNominal& b, const EskfNominal& a) {
-  EskfRts::VecP d = EskfRts::VecP::Zero();
-  d.head<nav::kDim>() = b.x.Boxminus(a.x);
-  eskf::SegmentOf<eskf::Block::kG>(d) = b.dg_w - a.dg_w;
-  d[eskf::kS] = b.scale - a.scale;
-  return d;
-}
-
-EskfNominal Plus(const EskfNominal& a, const EskfRts::VecP& d) {
-  EskfNominal b = a;
-  b.x = a.x.Boxplus(d.head<nav::kDim>());
-  b.dg_w = a.dg_w + eskf::SegmentOf<eskf::Block::kG>(d);
-  b.scale = a.scale + d[eskf::kS];
-  return b;
-}
-
 StateEstimate EstimateOf(const EskfNominal& n, const EskfRts::MatP& P) {
   StateEstimate e;
   e.x = n.x;
@@ -84,7 +42,7 @@ StateEstimate EstimateOf(const EskfNominal& n, const EskfRts::MatP& P) {
   e.sigma_v = eskf::BlockOf<eskf::Block::kV>(P).diagonal().cwiseMax(0.0).cwiseSqrt();
   const Mat3 R = n.x.R_wb();
   e.sigma_att = (R * eskf::BlockOf<eskf::Block::kTheta>(P) * R.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
-  e.odom_scale = n.scale;
+  e.odom_scale = n.Scalar<eskf::Block::kS>();
   return e;
 }
 
@@ -92,13 +50,13 @@ StateEstimate EstimateOf(const EskfNominal& n, const EskfRts::MatP& P) {
 
 // One node as it sits in the file: fixed size, so that the backward pass can seek to any of them.
 struct EskfRts::Node {
-  static constexpr int kDoubles = 2 + 2 * kNominalSize + 2 * kTriangle + kA * kA + kA * kB;
+  static constexpr int kDoubles = 2 + 2 * EskfNominal::kPackedSize + 2 * kTriangle + kA * kA + kA * kB;
   std::array<double, kDoubles> v{};
   double& t() { return v[0]; }
   double& chain_start() { return v[1]; }
   double* prior_x() { return v.data() + 2; }
-  double* post_x() { return v.data() + 2 + kNominalSize; }
-  double* prior_P() { return v.data() + 2 + 2 * kNominalSize; }
+  double* post_x() { return v.data() + 2 + EskfNominal::kPackedSize; }
+  double* prior_P() { return v.data() + 2 + 2 * EskfNominal::kPackedSize; }
   double* post_P() { return prior_P() + kTriangle; }
   double* phi_a() { return post_P() + kTriangle; }
   double* phi_c() { return phi_a() + kA * kA; }
@@ -171,8 +129,8 @@ void EskfRts::AfterUpdates(const EskfNominal& x, const MatP& P) {
   Node node;
   node.t() = open_t_;
   node.chain_start() = chain_start_ ? 1.0 : 0.0;
-  PackNominal(prior_x_, node.prior_x());
-  PackNominal(x, node.post_x());
+  prior_x_.Pack(node.prior_x());
+  x.Pack(node.post_x());
   PackSymmetric(prior_P_, node.prior_P());
   PackSymmetric(P, node.post_P());
   Eigen::Map<Eigen::Matrix<double, kA, kA>>(node.phi_a()) = phi_a_;
@@ -212,13 +170,13 @@ void EskfRts::Smooth(const EarthModel& earth, const StateCallback& out) {
       failed_ = true;
       return;
     }
-    const EskfNominal post = UnpackNominal(node.post_x(), node.t());
+    const EskfNominal post = EskfNominal::Unpack(node.post_x(), node.t());
     MatP P_post;
     UnpackSymmetric(node.post_P(), &P_post);
     EskfNominal xs = post;
     MatP Ps = P_post;
     if (i + 1 < nodes_ && next.chain_start() == 0.0) {
-      const EskfNominal prior_next = UnpackNominal(next.prior_x(), next.t());
+      const EskfNominal prior_next = EskfNominal::Unpack(next.prior_x(), next.t());
       MatP P_prior_next;
       UnpackSymmetric(next.prior_P(), &P_prior_next);
       // A state the filter does not estimate (the odometer scale without wheels, δg when held) has a zero
@@ -228,15 +186,15 @@ void EskfRts::Smooth(const EarthModel& earth, const StateCallback& out) {
       }
       VecP delta;
       MatP P_s;
-      if (RtsBackwardStep<kN>(P_post, next.Phi(), P_prior_next, Minus(xs_next, prior_next), Ps_next, &delta, &P_s)) {
-        xs = Plus(post, delta);
+      if (RtsBackwardStep<kN>(P_post, next.Phi(), P_prior_next, xs_next.Minus(prior_next), Ps_next, &delta, &P_s)) {
+        xs = post.Plus(delta);
         Ps = P_s;
       } else {
         ++singular_;  // keep the filtered node: the chain is smoothed again from here back
       }
     }
     smoothed[i] = EstimateOf(xs, Ps);
-    dg[i] = xs.dg_w;
+    dg[i] = xs.Get<eskf::Block::kG>();
     chain_start[i] = node.chain_start() != 0.0;
     xs_next = xs;
     Ps_next = Ps;

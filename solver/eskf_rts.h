@@ -49,13 +49,6 @@ bool RtsBackwardStep(const Eigen::Matrix<double, N, N>& P_post, const Eigen::Mat
   return delta->allFinite() && P_smooth->allFinite();
 }
 
-// The filter's full nominal state: NavState, the gravity correction δg and the odometer scale.
-struct EskfNominal {
-  NavState x;
-  Vec3 dg_w = Vec3::Zero();
-  double scale = 1.0;
-};
-
 class EskfRts {
  public:
   using MatP = Eigen::Matrix<double, eskf::kDim, eskf::kDim>;

@@ -5,8 +5,11 @@
 // - kinematic (δp, δv, δθ): the kernel's A;
 // - driving (δbg, δba, δg): they enter the kinematics through the kernel's B and G, and random-walk;
 // - passive (δs, ...): they do not enter the kinematics; constant or random walks.
+// The blocks after the NavState's are additive (Euclidean) in the nominal state too: EskfNominal keeps them
+// in one vector in table order, so box-plus, box-minus, packing and the finiteness check loop over the table.
 // A new state that does not enter the kinematics (e.g. a barometer bias) is one entry at the end of Block
-// and kBlocks, plus its own dynamics (Eskf::AddRandomWalks) and its measurement's Jacobian.
+// and kBlocks (with its nominal start value), plus its own dynamics (Eskf::AddRandomWalks) and its
+// measurement's Jacobian.
 #pragma once
 
 #include <Eigen/Core>
@@ -24,6 +27,7 @@ struct BlockInfo {
   Block block;
   std::string_view name;
   int dim;
+  double start = 0.0;  // an additive block's nominal value before any estimate (each component)
 };
 
 inline constexpr int kNumBlocks = static_cast<int>(Block::kCount);
@@ -35,7 +39,7 @@ inline constexpr std::array<BlockInfo, kNumBlocks> kBlocks = {{
     {Block::kBg, "bg", 3},        // gyro bias, rad/s
     {Block::kBa, "ba", 3},        // accelerometer bias, m/s²
     {Block::kG, "g", 3},          // gravity in w, m/s²
-    {Block::kS, "s", 1},          // odometer scale
+    {Block::kS, "s", 1, 1.0},     // odometer scale
 }};
 
 // The first block of the driving and of the passive group (see the top of the file).
@@ -99,5 +103,57 @@ auto ColsOf(Matrix& m) {
   return m.template middleCols<Dim(c)>(Offset(c));
 }
 
+// The additive blocks: those after the NavState's, in one vector.
+inline constexpr int kAdditiveDim = kDim - nav::kDim;
+static_assert(kAdditiveDim > 0, "at least one block after the NavState's");
+
 }  // namespace eskf
+
+// The filter's full nominal state: the NavState and the additive blocks (δg, the odometer scale, ...) in
+// table order. Box-plus/box-minus match the error state's layout (eskf::kBlocks).
+struct EskfNominal {
+  using Vec = Eigen::Matrix<double, eskf::kDim, 1>;
+  using Additive = Eigen::Matrix<double, eskf::kAdditiveDim, 1>;
+  // The packed form (eskf_rts.h's file): p, v, q (w x y z), bg, ba, then the additive blocks.
+  static constexpr int kPackedSize = 16 + eskf::kAdditiveDim;
+
+  NavState x;
+  Additive additive = Start();
+
+  // The additive blocks' start values (eskf::BlockInfo::start).
+  static Additive Start();
+
+  template <eskf::Block b>
+  auto Get() {
+    static_assert(eskf::Offset(b) >= nav::kDim, "an additive block");
+    return additive.template segment<eskf::Dim(b)>(eskf::Offset(b) - nav::kDim);
+  }
+  template <eskf::Block b>
+  auto Get() const {
+    static_assert(eskf::Offset(b) >= nav::kDim, "an additive block");
+    return additive.template segment<eskf::Dim(b)>(eskf::Offset(b) - nav::kDim);
+  }
+  // A one-dimensional additive block's value.
+  template <eskf::Block b>
+  double& Scalar() {
+    static_assert(eskf::Dim(b) == 1, "a scalar block");
+    return additive[eskf::Offset(b) - nav::kDim];
+  }
+  template <eskf::Block b>
+  double Scalar() const {
+    static_assert(eskf::Dim(b) == 1, "a scalar block");
+    return additive[eskf::Offset(b) - nav::kDim];
+  }
+
+  // This state moved by d; and this ⊟ a (the error state between them).
+  EskfNominal Plus(const Vec& d) const;
+  void PlusInPlace(const Vec& d);
+  Vec Minus(const EskfNominal& a) const;
+  bool AllFinite() const;
+  // Each additive block that is not finite back to its start value.
+  void ResetNonFinite();
+  void Pack(double* out) const;
+  static EskfNominal Unpack(const double* in, double t);
+};
+
 }  // namespace gins

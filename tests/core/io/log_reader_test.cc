@@ -226,6 +226,20 @@ TEST_F(LogReaderTest, ReorderWindowLetsSlightlyOlderRecordsThrough) {
   EXPECT_NE(on.stats.examples[0].detail.find("input.reorder_window_s"), std::string::npos);
 }
 
+// GNSS stamped late by its logger is written ahead of the IMU and ODOM records up to its stamp: each of
+// them is compared with the last record of its own type, so the IMU record at the fix's stamp is no
+// "duplicate" (one was skipped per fix, and a whole RTK drive stamped 0.1 s late was refused).
+TEST_F(LogReaderTest, RecordsReadAheadOfOthersInTheWindowAreNoDuplicates) {
+  const std::string text = Imu("1.0") + "\nGNSS 1.1 31.5 120.4 10.5 170.9 1\n" + Imu("1.05") + "\nODOM 1.05 1 1\n" +
+                           Imu("1.1") + "\nODOM 1.1 1 1\n" + Imu("1.15") + "\n" + Imu("1.15") + "\n";
+  InputOptions window;
+  window.reorder_window = 0.1;
+  const ReadResult r = ReadAll(Write("log.txt", text), window);
+  EXPECT_EQ(r.records.size(), 7u);
+  EXPECT_EQ(r.stats.skipped.at("duplicate"), 1u);  // the real one: a second IMU record at 1.15
+  EXPECT_EQ(r.stats.total_skipped(), 1u);
+}
+
 // A corrupted far-future time stamp costs that one line: the records after it are read (not out_of_order).
 TEST_F(LogReaderTest, FarFutureTimeStampIsOneTimeJumpNotEveryLaterLine) {
   std::string text;

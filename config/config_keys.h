@@ -57,7 +57,9 @@ inline constexpr auto kGnssKeys = [](auto& v, GnssOptions& o) {
   v.Vector3("sigma_m", o.sigma_enu, "[east, north, up]", Positive());
   v.Number("min_sigma_m", o.min_sigma, kNoUnit, Positive());
   v.Number("error_correlation_s", o.error_correlation, kNoUnit, NonNegative());
-  v.Number("time_offset_s", o.time_offset, kNoUnit, Within(-5.0, 5.0));
+  v.NumberOrWord("time_offset_s", o.time_offset, o.estimate_time_offset, "estimate", kNoUnit, Within(-5.0, 5.0));
+  v.Number("time_offset_sigma_s", o.time_offset_sigma, kNoUnit, Within(1e-6, 1.0));
+  v.Number("time_offset_rw_s_sqrt_s", o.time_offset_rw, kNoUnit, NonNegative());
   v.Number("heading_sigma_deg", o.heading_sigma, kDeg, Positive());
   v.Boolean("use_heading", o.use_heading);
   v.Number("gate_probability", o.gate_probability, kNoUnit, GateProbability());

@@ -21,6 +21,10 @@ class KeyLister {
     Add(key);
   }
   template <class... Rest>
+  void NumberOrWord(const char* key, Rest&&...) {
+    Add(key);
+  }
+  template <class... Rest>
   void Integer(const char* key, Rest&&...) {
     Add(key);
   }

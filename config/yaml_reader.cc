@@ -209,6 +209,22 @@ void YamlReader::Number(const char* key, double& out, const Unit& unit, const Ch
   if (n != nullptr) out = ReadNumber(*n, Path(key), unit, check);
 }
 
+void YamlReader::NumberOrWord(const char* key, double& out, bool& is_word, const char* word, const Unit& unit,
+                              const Check& check) {
+  const YAML::Node* n = Find(key);
+  if (n == nullptr) return;
+  if (IsPlainScalar(*n) && n->Scalar() == word) {
+    is_word = true;
+    return;
+  }
+  double v = 0.0;
+  if (!IsPlainScalar(*n) || !ParseDouble(n->Scalar(), &v)) {
+    ctx_.Fail(Path(key), std::string("expected a number or '") + word + "', got " + Describe(*n), n->Mark());
+  }
+  out = ReadNumber(*n, Path(key), unit, check);
+  is_word = false;
+}
+
 void YamlReader::Boolean(const char* key, bool& out) {
   const YAML::Node* n = Find(key);
   if (n == nullptr) return;

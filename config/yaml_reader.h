@@ -54,6 +54,10 @@ class YamlReader {
     if (const YAML::Node* n = Find(key)) out = static_cast<Int>(ReadInteger(*n, Path(key), min, max));
   }
 
+  // A number, or the one word `word` (is_word set, out untouched), e.g. `time_offset_s: estimate`.
+  void NumberOrWord(const char* key, double& out, bool& is_word, const char* word, const Unit& unit,
+                    const Check& check);
+
   void Boolean(const char* key, bool& out);
 
   template <class T>

@@ -35,6 +35,10 @@ class YamlWriter {
   void Integer(const char* key, Int value, long long /*min*/, long long /*max*/ = 0) {
     Put(key, std::to_string(value));
   }
+  void NumberOrWord(const char* key, double value, bool is_word, const char* word, const Unit& unit,
+                    const Check& /*check*/) {
+    Put(key, is_word ? std::string(word) : FormatNumber(value, unit));
+  }
   void Boolean(const char* key, bool value) { Put(key, value ? "true" : "false"); }
 
   template <class T>

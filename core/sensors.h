@@ -34,8 +34,13 @@ struct GnssOptions {
   Vec3 sigma_enu = Vec3(0.05, 0.05, 0.10);  // gnss.sigma_m [e, n, u]: used when a fix carries no σ
   double min_sigma = 0.005;                // gnss.min_sigma_m: floor for logged σ (a zero σ is not trusted)
   // gnss.time_offset_s: the GNSS records (fixes, headings, velocities) are stamped this much after the IMU
-  // time at which they were measured (a receiver's latency into the logger); gins takes t − offset.
+  // time at which they were measured (a receiver's latency into the logger). A number: gins takes t − offset.
+  // `estimate` (estimate_time_offset): the ESKF estimates the rest as a state (solver/eskf.h), from 0 with
+  // 1-σ time_offset_sigma and a random walk time_offset_rw; the smoothers take time_offset.
   double time_offset = 0.0;
+  bool estimate_time_offset = false;
+  double time_offset_sigma = 0.1;  // gnss.time_offset_sigma_s
+  double time_offset_rw = 1e-4;    // gnss.time_offset_rw_s_sqrt_s → s/√s
   // gnss.error_correlation_s: correlation time τ of the fixes' errors; each σ is inflated by
   // √((1+ρ)/(1−ρ)), ρ = exp(−Δt/τ), Δt the spacing of the fixes (core/gnss_noise.h). 0: independent fixes.
   double error_correlation = 0.0;

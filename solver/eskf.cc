@@ -17,6 +17,7 @@ namespace gins {
 
 using eskf::Block;
 using eskf::BlockOf;
+constexpr int kTd = eskf::Offset(Block::kTd);
 
 namespace {
 
@@ -197,6 +198,9 @@ void Eskf::SetAdditivePriors() {
   if (options_.wheel.enabled && options_.wheel.estimate_scale) {
     P_(eskf::kS, eskf::kS) = options_.wheel.scale_sigma * options_.wheel.scale_sigma;
   }
+  if (options_.gnss.estimate_time_offset) {
+    P_(kTd, kTd) = options_.gnss.time_offset_sigma * options_.gnss.time_offset_sigma;
+  }
 }
 
 void Eskf::AddRandomWalks(double dt) {
@@ -207,6 +211,7 @@ void Eskf::AddRandomWalks(double dt) {
   if (options_.wheel.enabled && options_.wheel.estimate_scale) {
     P_(eskf::kS, eskf::kS) += options_.wheel.scale_rw * options_.wheel.scale_rw * dt;
   }
+  if (options_.gnss.estimate_time_offset) P_(kTd, kTd) += options_.gnss.time_offset_rw * options_.gnss.time_offset_rw * dt;
 }
 
 void Eskf::AddImu(const ImuSample& imu) {
@@ -378,6 +383,10 @@ nlohmann::json Eskf::Stats() const {
   j["gnss_reacquired"] = gnss_inflation_.reacquired();
   j["zero_velocity"] = zupt_counts_.ToJson();
   j["final_odom_scale"] = nom_.Scalar<Block::kS>();
+  // The GNSS time offset: the stated value plus the estimated part (gnss.time_offset_s).
+  j["time_offset"] = {{"estimated", options_.gnss.estimate_time_offset},
+                      {"final_s", options_.gnss.time_offset + nom_.Scalar<Block::kTd>()},
+                      {"final_sigma_s", std::sqrt(std::max(P_(kTd, kTd), 0.0))}};
   const Vec3 g_w = gravity();
   j["final_gravity"] = {g_w.x(), g_w.y(), g_w.z()};
   j["final_gyro_bias_deg_h"] = {nom_.x.bg.x() * kRadToDeg * 3600, nom_.x.bg.y() * kRadToDeg * 3600, nom_.x.bg.z() * kRadToDeg * 3600};

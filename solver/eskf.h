@@ -93,7 +93,7 @@ class Eskf : public Estimator {
   void FlushCovariance();
   // The covariance over a step no IMU sample covers (an IMU gap): see kImuGapAccDensity.
   void CoastCovariance(double dt);
-  // The prior variances of the additive blocks (δg, s) that are estimated; and their random walks, with
+  // The prior variances of the additive blocks (δg, s, td) that are estimated; and their random walks, with
   // the biases', over dt.
   void SetAdditivePriors();
   void AddRandomWalks(double dt);

@@ -7,6 +7,7 @@
 #include "core/heading_model.h"
 #include "core/linearize.h"
 #include "core/so3.h"
+#include "core/time_shift.h"
 #include "core/wheel_model.h"
 #include "solver/eskf.h"
 
@@ -23,6 +24,15 @@ namespace {
 template <typename T>
 Eigen::Quaternion<T> Rotated(const NavState& x, const Eigen::Matrix<T, 3, 1>& d_theta) {
   return x.q_wb.cast<T>() * ExpQuat<T>(d_theta);
+}
+
+// The state at the GNSS record's measurement time, t − td (core/time_shift.h), perturbed by (δp, δθ, δv, δtd).
+template <typename T>
+ShiftedKinematics<T> ShiftedState(const NavState& x, double td, const Vec3& a_w, const Vec3& omega_b,
+                                  const Eigen::Matrix<T, 3, 1>& dp, const Eigen::Matrix<T, 3, 1>& d_theta,
+                                  const Eigen::Matrix<T, 3, 1>& dv, const T& d_td) {
+  return ShiftBack<T>(x.p_wb.cast<T>() + dp, x.v_w.cast<T>() + dv, Rotated<T>(x, d_theta), a_w, omega_b,
+                      T(td) + d_td);
 }
 
 }  // namespace
@@ -53,18 +63,22 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
 }
 
 bool Eskf::UpdateGnssPosition(const GnssMeasurement& m) {
+  const Vec3 omega_b = BodyRate();
   const Model<3> model = [&] {
     Eigen::Matrix<double, 3, 1> r;
-    Eigen::Matrix<double, 3, 6> H6;  // (δp, δθ)
-    Linearize<3, 6>(
+    Eigen::Matrix<double, 3, 10> H;  // (δp, δθ, δv, δtd)
+    Linearize<3, 10>(
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
-          const Eigen::Matrix<T, 3, 1> p = nom_.x.p_wb.cast<T>() + d.template head<3>();
-          return GnssPositionModel::Residual<T>(p, Rotated<T>(nom_.x, d.template tail<3>()), options_.gnss.lever_b,
-                                                m.p_w);
+          const ShiftedKinematics<T> k = ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, d.template head<3>(), d.template segment<3>(3),
+                                                    d.template segment<3>(6), d[9]);
+          return GnssPositionModel::Residual<T>(k.p_wb, k.q_wb, options_.gnss.lever_b, m.p_w);
         },
-        &r, &H6);
-    return Linearized<3>{r, EmbedJacobian<3>({{Block::kP, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}})};
+        &r, &H);
+    return Linearized<3>{r, EmbedJacobian<3>({{Block::kP, H.leftCols<3>()},
+                                              {Block::kTheta, H.middleCols<3>(3)},
+                                              {Block::kV, H.middleCols<3>(6)},
+                                              {Block::kTd, H.rightCols<1>()}})};
   };
   const Mat3 R = m.sigma_w.cwiseAbs2().asDiagonal();
   const double inflation = gnss_inflation_.factor();
@@ -81,17 +95,19 @@ bool Eskf::UpdateGnssPosition(const GnssMeasurement& m) {
 }
 
 void Eskf::UpdateHeading(const GnssMeasurement& m) {
+  const Vec3 omega_b = BodyRate();
   const Model<1> model = [&] {
     Eigen::Matrix<double, 1, 1> r;
-    Eigen::Matrix<double, 1, 3> H3;
-    Linearize<1, 3>(
+    Eigen::Matrix<double, 1, 4> H;  // (δθ, δtd)
+    Linearize<1, 4>(
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
-          return Eigen::Matrix<T, 1, 1>(
-              HeadingModel::Residual<T>(Rotated<T>(nom_.x, Eigen::Matrix<T, 3, 1>(d)), options_.gnss.mount_yaw, m.yaw_G));
+          const Eigen::Matrix<T, 3, 1> zero = Eigen::Matrix<T, 3, 1>::Zero();
+          const ShiftedKinematics<T> k = ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, zero, d.template head<3>(), zero, d[3]);
+          return Eigen::Matrix<T, 1, 1>(HeadingModel::Residual<T>(k.q_wb, options_.gnss.mount_yaw, m.yaw_G));
         },
-        &r, &H3);
-    return Linearized<1>{r, EmbedJacobian<1>({{Block::kTheta, H3}})};
+        &r, &H);
+    return Linearized<1>{r, EmbedJacobian<1>({{Block::kTheta, H.leftCols<3>()}, {Block::kTd, H.rightCols<1>()}})};
   };
   Update<1>(model, Eigen::Matrix<double, 1, 1>(m.sigma_yaw * m.sigma_yaw), gate_heading_, &heading_counts_, m.t);
 }
@@ -103,16 +119,18 @@ void Eskf::AddGvel(const GvelMeasurement& m) {
   const Vec3 omega_b = BodyRate();
   const Model<3> model = [&] {
     Eigen::Matrix<double, 3, 1> r;
-    Eigen::Matrix<double, 3, 6> H6;  // (δv, δθ)
-    Linearize<3, 6>(
+    Eigen::Matrix<double, 3, 7> H;  // (δv, δθ, δtd)
+    Linearize<3, 7>(
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
-          const Eigen::Matrix<T, 3, 1> v = nom_.x.v_w.cast<T>() + d.template head<3>();
-          return GnssVelocityModel::Residual<T>(Rotated<T>(nom_.x, d.template tail<3>()), v, omega_b,
-                                                options_.gnss.lever_b, m.v_w);
+          const ShiftedKinematics<T> k = ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, Eigen::Matrix<T, 3, 1>::Zero(), d.template segment<3>(3),
+                                                    d.template head<3>(), d[6]);
+          return GnssVelocityModel::Residual<T>(k.q_wb, k.v_w, omega_b, options_.gnss.lever_b, m.v_w);
         },
-        &r, &H6);
-    return Linearized<3>{r, EmbedJacobian<3>({{Block::kV, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}})};
+        &r, &H);
+    return Linearized<3>{r, EmbedJacobian<3>({{Block::kV, H.leftCols<3>()},
+                                              {Block::kTheta, H.middleCols<3>(3)},
+                                              {Block::kTd, H.rightCols<1>()}})};
   };
   Update<3>(model, Mat3(m.sigma_w.cwiseAbs2().asDiagonal()), gate_gnss_, &gvel_counts_, m.t);
 }

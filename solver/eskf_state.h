@@ -21,7 +21,7 @@
 namespace gins {
 namespace eskf {
 
-enum class Block : int { kP, kV, kTheta, kBg, kBa, kG, kS, kCount };
+enum class Block : int { kP, kV, kTheta, kBg, kBa, kG, kS, kTd, kCount };
 
 struct BlockInfo {
   Block block;
@@ -40,6 +40,7 @@ inline constexpr std::array<BlockInfo, kNumBlocks> kBlocks = {{
     {Block::kBa, "ba", 3},        // accelerometer bias, m/s²
     {Block::kG, "g", 3},          // gravity in w, m/s²
     {Block::kS, "s", 1, 1.0},     // odometer scale
+    {Block::kTd, "td", 1},        // GNSS time offset beyond gnss.time_offset_s's value, s (core/time_shift.h)
 }};
 
 // The first block of the driving and of the passive group (see the top of the file).

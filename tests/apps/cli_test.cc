@@ -402,8 +402,9 @@ TEST_F(CliRun, CrossStreamJitterRunsWithTheDefaultConfig) {
 }
 
 // GNSS records stamped 0.1 s late (a receiver's latency into the logger): with gnss.time_offset_s: 0.1 the
-// run is as accurate as on the log stamped right (within 10 % + 5 mm); without it, far worse.
-TEST_F(CliRun, AStatedGnssTimeOffsetUndoesTheLatency) {
+// run is as accurate as on the log stamped right (within 10 % + 5 mm); held at 0, far worse; `estimate`
+// finds the 0.1 s within 5 ms (and 0 on the log stamped right) and the ESKF is as accurate as when stated.
+TEST_F(CliRun, AGnssTimeOffsetStatedOrEstimatedUndoesTheLatency) {
   ASSERT_EQ(sim_exit_, 0);
   std::string late;
   for (const std::string& line : Lines(test::ReadFile(log_))) {
@@ -416,25 +417,44 @@ TEST_F(CliRun, AStatedGnssTimeOffsetUndoesTheLatency) {
     }
     late += line + "\n";
   }
-  const std::string log = dir_ + "/log_late.txt", offset_config = dir_ + "/offset.yaml";
+  const std::string log = dir_ + "/log_late.txt", offset_config = dir_ + "/offset.yaml",
+                    estimate_config = dir_ + "/estimate.yaml";
   test::WriteFile(log, late);
   test::WriteFile(offset_config, test::ReadFile(config_) + "gnss:\n  time_offset_s: 0.1\n");
-  const auto rmse = [&](const std::string& config, const std::string& log_path, const std::string& out) {
+  test::WriteFile(estimate_config, test::ReadFile(config_) + "gnss:\n  time_offset_s: estimate\n");
+  struct Run {
+    double eskf, smoother, offset, offset_sigma;
+  };
+  const auto run = [&](const std::string& config, const std::string& log_path, const std::string& out) {
     EXPECT_EQ(RunCliInChild({"run", "--config", config, "--log", log_path, "--out", out, "--mode", "both", "--truth",
                              truth_}),
               0);
     const nlohmann::json s = Summary(out);
-    return std::make_pair(s["accuracy"]["eskf"]["rmse_horizontal_m"].get<double>(),
-                          s["accuracy"]["smoother"]["rmse_horizontal_m"].get<double>());
+    const nlohmann::json& offset = s["estimators"]["eskf"]["time_offset"];
+    return Run{s["accuracy"]["eskf"]["rmse_horizontal_m"].get<double>(),
+               s["accuracy"]["smoother"]["rmse_horizontal_m"].get<double>(), offset["final_s"].get<double>(),
+               offset["final_sigma_s"].get<double>()};
   };
-  const auto clean = rmse(config_, log_, dir_ + "/out_offset_clean");
-  const auto stated = rmse(offset_config, log, dir_ + "/out_offset_stated");
-  const auto unstated = rmse(config_, log, dir_ + "/out_offset_unstated");
-  std::printf("eskf / smoother rmse_h: clean %.4f / %.4f, 0.1 s late and stated %.4f / %.4f, not stated %.4f / %.4f\n",
-              clean.first, clean.second, stated.first, stated.second, unstated.first, unstated.second);
-  EXPECT_LT(stated.first, 1.1 * clean.first + 0.005);
-  EXPECT_LT(stated.second, 1.1 * clean.second + 0.005);
-  EXPECT_GT(unstated.first, 2.0 * clean.first);
+  const Run clean = run(config_, log_, dir_ + "/out_offset_clean");
+  const Run stated = run(offset_config, log, dir_ + "/out_offset_stated");
+  const Run unstated = run(config_, log, dir_ + "/out_offset_unstated");
+  const Run estimated = run(estimate_config, log, dir_ + "/out_offset_estimated");
+  const Run estimated_clean = run(estimate_config, log_, dir_ + "/out_offset_estimated_clean");
+  std::printf("eskf / smoother rmse_h: clean %.4f / %.4f, 0.1 s late and stated %.4f / %.4f, held at 0 %.4f / %.4f\n",
+              clean.eskf, clean.smoother, stated.eskf, stated.smoother, unstated.eskf, unstated.smoother);
+  std::printf("estimated: late %.4f m, offset %.4f +- %.4f s; clean %.4f m, offset %.4f +- %.4f s\n", estimated.eskf,
+              estimated.offset, estimated.offset_sigma, estimated_clean.eskf, estimated_clean.offset,
+              estimated_clean.offset_sigma);
+  EXPECT_LT(stated.eskf, 1.1 * clean.eskf + 0.005);
+  EXPECT_LT(stated.smoother, 1.1 * clean.smoother + 0.005);
+  EXPECT_GT(unstated.eskf, 2.0 * clean.eskf);
+  EXPECT_NEAR(estimated.offset, 0.1, 0.005);
+  EXPECT_NEAR(estimated_clean.offset, 0.0, 0.005);
+  EXPECT_LT(estimated.offset_sigma, 0.01);  // the 40 s drive's turn and stop observe it
+  // Latency estimated costs what it costs on the log stamped right; there, the offset's own σ along the
+  // track (at the drive's 10 m/s at most) is what estimating costs against holding it at the true 0.
+  EXPECT_LT(estimated.eskf, 1.1 * estimated_clean.eskf + 0.005);
+  EXPECT_LT(estimated_clean.eskf, 1.1 * clean.eskf + 10.0 * estimated_clean.offset_sigma);
 }
 
 TEST_F(CliRun, BadConfigKeyWritesNothing) {

@@ -710,5 +710,24 @@ TEST(ConfigLoaderTest, EchoWritesSegmentsOutagesAndMatrices) {
   EXPECT_NE(yaml.find("initial_heading_deg: 30"), std::string::npos) << yaml;
 }
 
+// gnss.time_offset_s: a number (held) or `estimate` (a state in the ESKF); the writer writes back what was read.
+TEST(ConfigLoaderTest, GnssTimeOffsetIsANumberOrEstimate) {
+  const Options held = Load("gnss: {time_offset_s: 0.12}");
+  EXPECT_EQ(held.gnss.time_offset, 0.12);
+  EXPECT_FALSE(held.gnss.estimate_time_offset);
+  const Options estimated = Load("gnss: {time_offset_s: estimate, time_offset_sigma_s: 0.2}");
+  EXPECT_TRUE(estimated.gnss.estimate_time_offset);
+  EXPECT_EQ(estimated.gnss.time_offset, 0.0);
+  EXPECT_EQ(estimated.gnss.time_offset_sigma, 0.2);
+  EXPECT_NE(OptionsToYaml(estimated).find("  time_offset_s: estimate\n"), std::string::npos);
+  EXPECT_TRUE(Load(OptionsToYaml(estimated)).gnss.estimate_time_offset);
+  EXPECT_NE(OptionsToYaml(held).find("  time_offset_s: 0.12\n"), std::string::npos);
+  ExpectErrors({
+      {"gnss: {time_offset_s: estimated}", {"gnss.time_offset_s: expected a number or 'estimate'", "estimated"}},
+      {"gnss: {time_offset_s: 7}", {"gnss.time_offset_s: must be within [-5, 5]"}},
+      {"gnss: {time_offset_s: [0.1]}", {"gnss.time_offset_s: expected a number or 'estimate'"}},
+  });
+}
+
 }  // namespace
 }  // namespace gins

@@ -31,8 +31,9 @@ TEST(EskfState, NamesAreUnique) {
 }
 
 TEST(EskfState, TodaysLayout) {
-  // δp, δv, δθ, δbg, δba, δg, δs: the NavState tangent first (core/nav_state.h), then gravity and scale.
-  EXPECT_EQ(kDim, 19);
+  // δp, δv, δθ, δbg, δba, δg, δs, δtd: the NavState tangent first (core/nav_state.h), then gravity, scale and
+  // the GNSS time offset.
+  EXPECT_EQ(kDim, 20);
   EXPECT_EQ(Offset(Block::kP), nav::kP);
   EXPECT_EQ(Offset(Block::kV), nav::kV);
   EXPECT_EQ(Offset(Block::kTheta), nav::kTheta);
@@ -41,6 +42,8 @@ TEST(EskfState, TodaysLayout) {
   EXPECT_EQ(kG, 15);
   EXPECT_EQ(kS, 18);
   EXPECT_EQ(Dim(Block::kS), 1);
+  EXPECT_EQ(Offset(Block::kTd), 19);
+  EXPECT_EQ(kAdditiveDim, 5);
   EXPECT_EQ(kMaxBlockDim, 3);
 }
 

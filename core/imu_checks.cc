@@ -142,3 +142,82 @@ void TurnRateCheck::Decide() {
 }
 
 }  // namespace gins
+
+namespace gins {
+
+namespace {
+
+// The mean of two yaws (rad), on the circle.
+double MeanYaw(double a, double b) { return WrapAngle(a + 0.5 * WrapAngle(b - a)); }
+
+}  // namespace
+
+void HeadingCourseCheck::AddFix(double t, const Vec3& p_w, double sigma_h, double heading_deg, double mount_yaw) {
+  if (outcome_ != Outcome::kPending || !p_w.allFinite() || !std::isfinite(heading_deg)) return;
+  const Fix f{t, p_w, sigma_h, heading_deg};
+  if (!have_anchor_ || t - anchor_.t > 5.0 || t <= anchor_.t) {  // too slow (or a gap) for a course
+    anchor_ = f;
+    have_anchor_ = true;
+    return;
+  }
+  const Vec3 d = f.p_w - anchor_.p_w;
+  if (d.head<2>().norm() < std::max(kMinStep, 10.0 * std::max(anchor_.sigma_h, sigma_h))) return;
+  const double course = std::atan2(d.y(), d.x());
+  // The course unwrapped, and its range over the chords kept (the courses' noise does not add up in it).
+  unwrapped_ = have_course_ ? unwrapped_ + WrapAngle(course - last_course_) : 0.0;
+  if (!have_course_ || d_deg_.empty()) low_ = high_ = unwrapped_;
+  low_ = std::min(low_, unwrapped_);
+  high_ = std::max(high_, unwrapped_);
+  have_course_ = true;
+  last_course_ = course;
+  const auto offset = [&](double scale) {
+    const double yaw = MeanYaw(CompassDegToEnuYaw(scale * anchor_.heading_deg), CompassDegToEnuYaw(scale * heading_deg));
+    return WrapAngle(yaw - mount_yaw - course);
+  };
+  d_deg_.push_back(offset(1.0));
+  d_rad_.push_back(offset(kRadToDeg));
+  anchor_ = f;
+  if (pairs() >= kPairs) Decide(mount_yaw);
+}
+
+void HeadingCourseCheck::Decide(double mount_yaw) {
+  const auto within = [](const std::vector<double>& d) {
+    int n = 0;
+    for (double x : d) n += std::abs(x) < kTolerance;
+    return n;
+  };
+  const int need = (4 * pairs() + 4) / 5;  // 80 %
+  // The offsets' circular mean and spread (1 − mean resultant length ≈ σ²/2).
+  double c = 0.0, s = 0.0;
+  for (double x : d_deg_) c += std::cos(x), s += std::sin(x);
+  const double mean = std::atan2(s, c), resultant = std::hypot(c, s) / pairs();
+  const double spread = std::sqrt(std::max(0.0, 2.0 * (1.0 - resultant)));
+  char buf[512];
+  if (within(d_deg_) >= need) {
+    outcome_ = Outcome::kOk;
+  } else if (within(d_rad_) >= need) {
+    outcome_ = Outcome::kRefuse;
+    message_ = "the dual-antenna headings are in radians, not degrees (the GNSS records' heading column; multiply "
+               "it by 57.2958)";
+  } else if (spread < 0.5 * kTolerance && std::abs(mean) < 150.0 * kDegToRad) {
+    if (high_ - low_ < kMinTurn) {  // keep the newest chords: the turns to come decide
+      if (pairs() > 4 * kPairs) {
+        d_deg_.erase(d_deg_.begin(), d_deg_.begin() + 2 * kPairs);
+        d_rad_.erase(d_rad_.begin(), d_rad_.begin() + 2 * kPairs);
+        low_ = high_ = unwrapped_;  // conservatively: the range from here
+      }
+      return;
+    }
+    outcome_ = Outcome::kRefuse;
+    std::snprintf(buf, sizeof(buf),
+                  "the dual-antenna heading is %.1f° off the GNSS track's course on straight and turning stretches "
+                  "alike: gnss.mount_yaw_deg (%.2f) should be about %.2f",
+                  mean * kRadToDeg, mount_yaw * kRadToDeg, (mount_yaw + mean) * kRadToDeg);
+    message_ = buf;
+  } else {
+    d_deg_.clear();  // manoeuvres or reversing: judge the next chords afresh
+    d_rad_.clear();
+  }
+}
+
+}  // namespace gins

@@ -88,3 +88,52 @@ class TurnRateCheck {
 };
 
 }  // namespace gins
+
+namespace gins {
+
+// The dual-antenna heading against the GNSS track's course, for a car (README "Sanity checks"; its yaw is
+// its course, sideslip a few degrees). Over successive fixes with a valid heading at least kMinStep and 10 σ
+// apart (within 5 s), the chord's course is compared with the mean of the two headings less the mount
+// (gnss.mount_yaw_deg): d = heading − mount − course. After kPairs such chords:
+//   most |d| within kTolerance: ok;
+//   most within it once the logged headings are read as radians: refused (the column is in radians);
+//   one offset for all (spread under kTolerance / 2, not the 180° of reversing) once the course has
+//       spanned kMinTurn over those chords (on a straight road a constant offset may be a stuck heading): refused,
+//       naming gnss.mount_yaw_deg and the offset measured;
+//   anything else (reversing, manoeuvres, a poor heading): still watching, from the next chords.
+class HeadingCourseCheck {
+ public:
+  static constexpr int kPairs = 20;
+  static constexpr double kMinStep = 2.0;                   // m
+  static constexpr double kTolerance = 10.0 * kDegToRad;   // rad
+  static constexpr double kMinTurn = 45.0 * kDegToRad;     // rad of course change before a mount verdict
+
+  enum class Outcome { kPending, kOk, kRefuse };
+
+  // A fix with a valid heading: its position in w (east, north), horizontal 1-σ (m), the heading as logged
+  // (deg clockwise from north) and the configured mount yaw (rad).
+  void AddFix(double t, const Vec3& p_w, double sigma_h, double heading_deg, double mount_yaw);
+  Outcome outcome() const { return outcome_; }
+  const std::string& message() const { return message_; }
+  int pairs() const { return static_cast<int>(d_deg_.size()); }
+
+ private:
+  void Decide(double mount_yaw);
+
+  struct Fix {
+    double t;
+    Vec3 p_w;
+    double sigma_h, heading_deg;
+  };
+  bool have_anchor_ = false;
+  Fix anchor_{};
+  // d per chord, with the headings read as logged (degrees) and as radians.
+  std::vector<double> d_deg_, d_rad_;
+  bool have_course_ = false;
+  double last_course_ = 0.0, unwrapped_ = 0.0;
+  double low_ = 0.0, high_ = 0.0;  // the unwrapped course's range over the chords kept
+  Outcome outcome_ = Outcome::kPending;
+  std::string message_;
+};
+
+}  // namespace gins

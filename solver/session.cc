@@ -357,8 +357,13 @@ void Session::AddGnss(const GnssRecord& g) {
   m.sigma_yaw = options_.gnss.heading_sigma;
   if (standstill_) standstill_->AddGnss(m);
   if (options_.vehicle.nonholonomic) {
-    turn_check_.AddFix(m.t, m.p_w, m.sigma_w.head<2>().norm() / std::sqrt(2.0));
+    const double sigma_h = m.sigma_w.head<2>().norm() / std::sqrt(2.0);
+    turn_check_.AddFix(m.t, m.p_w, sigma_h);
     if (turn_check_.outcome() == TurnRateCheck::Outcome::kRefuse) throw RunError(turn_check_.message());
+    if (g.heading_valid && options_.gnss.use_heading) {
+      heading_check_.AddFix(m.t, m.p_w, sigma_h, g.heading_deg, options_.gnss.mount_yaw);
+      if (heading_check_.outcome() == HeadingCourseCheck::Outcome::kRefuse) throw RunError(heading_check_.message());
+    }
   }
   if (!initialized_) {
     init_->AddGnss(m);
@@ -436,6 +441,10 @@ nlohmann::json Session::Stats() const {
                             {"course_per_gyro", turn_check_.slope()},
                             {"correlation", turn_check_.correlation()},
                             {"turned_deg", turn_check_.turned() * kRadToDeg}};
+    if (options_.gnss.use_heading) {
+      j["heading_check"] = {
+          {"verdict", heading_check_.outcome() == HeadingCourseCheck::Outcome::kOk ? "ok" : "undecided"}};
+    }
   }
   // Simulated outages as absolute [begin, end) windows, and the log's own GNSS gaps.
   nlohmann::json outages = nlohmann::json::array(), gaps = nlohmann::json::array();

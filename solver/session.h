@@ -125,6 +125,7 @@ class Session {
   // The IMU's units and axes from its first records (core/imu_checks.h): refused with the reason, or warned.
   ImuAxesAndUnitsCheck imu_check_;
   TurnRateCheck turn_check_;  // for a car (vehicle.nonholonomic): the gyro against the GNSS track's turns
+  HeadingCourseCheck heading_check_;  // and the dual-antenna heading against the track's course
   std::string imu_warning_;
 
   // Standstill detection (core/standstill_detector.h), fed from the initialiser's start; after

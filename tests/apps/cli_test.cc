@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -554,6 +555,38 @@ TEST_F(CliRun, WrongImuUnitsOrAxesAreRefusedAndNamed) {
   EXPECT_EQ(RunCliInChild({"run", "--config", frd_config, "--log", dir_ + "/imu_frd.txt", "--out", dir_ + "/out_frd_ok",
                            "--mode", "eskf"}),
             0);
+}
+
+// Dual-antenna headings written in radians (core/imu_checks.h, HeadingCourseCheck): refused once the car has
+// driven 20 courses, naming the column; the same log in degrees runs (the fixture's own runs).
+TEST_F(CliRun, HeadingInRadiansIsRefusedAndNamed) {
+  ASSERT_EQ(sim_exit_, 0);
+  std::string text;
+  int converted = 0;
+  for (const std::string& line : Lines(test::ReadFile(log_))) {
+    std::istringstream in(line);
+    std::vector<std::string> f{std::istream_iterator<std::string>(in), std::istream_iterator<std::string>()};
+    if (f.size() < 7 || f[0] != "GNSS") {
+      text += line + "\n";
+      continue;
+    }
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%.6f", std::stod(f[5]) * kDegToRad);
+    f[5] = buf;
+    converted += f[6] == "1";
+    for (size_t i = 0; i < f.size(); ++i) text += (i ? " " : "") + f[i];
+    text += "\n";
+  }
+  ASSERT_GT(converted, 30);
+  const std::string log = dir_ + "/heading_rad.txt", out = dir_ + "/out_heading_rad";
+  test::WriteFile(log, text);
+  std::string err;
+  EXPECT_EQ(RunCliCapturingStderr({"run", "--config", config_, "--log", log, "--out", out, "--mode", "both"},
+                                  out + ".err", &err),
+            1);
+  EXPECT_NE(err.find("gins: error: " + log + ": "), std::string::npos) << err;
+  EXPECT_NE(err.find("headings are in radians, not degrees"), std::string::npos) << err;
+  EXPECT_EQ(FilesIn(out), 0u);
 }
 
 TEST_F(CliRun, LogThatNeverInitialisesWritesNothing) {

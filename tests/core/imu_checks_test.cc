@@ -108,5 +108,53 @@ TEST(TurnRateCheck, AMirroredTrackIsRefusedAndNamed) {
   EXPECT_EQ(Drive(0.05, 2.0, false, &other), TurnRateCheck::Outcome::kPending);
 }
 
+// A car at 10 m/s, straight for 10 s, then turning at `rate`, with 1 Hz RTK fixes and a dual-antenna
+// heading mounted at `mount` (true), logged in degrees or, by mistake, in radians; the check is told
+// `configured_mount`.
+HeadingCourseCheck::Outcome HeadingDrive(double rate, bool in_radians, double mount, double configured_mount,
+                                         HeadingCourseCheck* check) {
+  double yaw = 0.3;
+  Vec3 p = Vec3::Zero();
+  for (int k = 0; k <= 6000; ++k) {
+    const double t = 0.01 * k;
+    if (k % 100 == 0) {
+      double heading_deg = 90.0 - (yaw + mount) * kRadToDeg;  // compass, clockwise from north
+      heading_deg = std::fmod(heading_deg + 720.0, 360.0);
+      check->AddFix(t, p, 0.02, in_radians ? heading_deg * kDegToRad : heading_deg, configured_mount);
+    }
+    yaw += (t < 10.0 ? 0.0 : rate) * 0.01;
+    p += 10.0 * 0.01 * Vec3(std::cos(yaw), std::sin(yaw), 0.0);
+  }
+  return check->outcome();
+}
+
+TEST(HeadingCourseCheck, AHeadingThatFollowsTheCourseIsOk) {
+  HeadingCourseCheck check;
+  EXPECT_EQ(HeadingDrive(0.05, false, 0.21, 0.21, &check), HeadingCourseCheck::Outcome::kOk);
+  HeadingCourseCheck straight;
+  EXPECT_EQ(HeadingDrive(0.0, false, -1.2, -1.2, &straight), HeadingCourseCheck::Outcome::kOk);
+}
+
+TEST(HeadingCourseCheck, HeadingsInRadiansAreRefusedAndNamed) {
+  for (const double rate : {0.0, 0.05}) {
+    HeadingCourseCheck check;
+    EXPECT_EQ(HeadingDrive(rate, true, 0.21, 0.21, &check), HeadingCourseCheck::Outcome::kRefuse) << rate;
+    EXPECT_NE(check.message().find("in radians, not degrees"), std::string::npos) << check.message();
+  }
+}
+
+TEST(HeadingCourseCheck, AWrongMountAngleIsRefusedWithTheOffsetMeasured) {
+  HeadingCourseCheck check;
+  EXPECT_EQ(HeadingDrive(0.05, false, 0.21, 0.21 + 30.0 * kDegToRad, &check), HeadingCourseCheck::Outcome::kRefuse);
+  EXPECT_NE(check.message().find("gnss.mount_yaw_deg (42.03) should be about 12.0"), std::string::npos)
+      << check.message();
+  // A mount within the tolerance (a few degrees: the heading update itself handles it) is not refused.
+  // On a straight road a constant offset may be a stuck heading as well: not refused without turns.
+  HeadingCourseCheck straight;
+  EXPECT_EQ(HeadingDrive(0.0, false, 0.21, 0.21 + 30.0 * kDegToRad, &straight), HeadingCourseCheck::Outcome::kPending);
+  HeadingCourseCheck close;
+  EXPECT_EQ(HeadingDrive(0.05, false, 0.21, 0.21 + 3.0 * kDegToRad, &close), HeadingCourseCheck::Outcome::kOk);
+}
+
 }  // namespace
 }  // namespace gins

@@ -93,8 +93,9 @@ void LogReader::Impl::Damage(uint64_t line, const char* reason, const std::strin
   }
   if (options_.max_errors < 0 || skipped_ > static_cast<uint64_t>(options_.max_errors)) {
     done_ = true;
-    throw InputError(where + "too many damaged lines (" + std::to_string(skipped_) + "), last: " + reason +
-                     " (input.max_errors = " + std::to_string(options_.max_errors) + ")");
+    // The last line's detail too: it names the cause (time in ms: "not seconds?") as on_error: stop would.
+    throw InputError(where + "too many damaged lines (" + std::to_string(skipped_) + "), last: " + reason + ": " +
+                     detail + " (input.max_errors = " + std::to_string(options_.max_errors) + ")");
   }
 }
 

@@ -452,6 +452,24 @@ TEST_F(LogReaderTest, TooManyDamagedLinesThrows) {
   }
 }
 
+// A log with its times in milliseconds: refused under the default policy too with the hint the last line's
+// detail gives ("not seconds?"), not only with on_error: stop.
+TEST_F(LogReaderTest, TimesInMillisecondsAreRefusedWithTheHint) {
+  std::string text;
+  for (int i = 0; i < 20; ++i) text += Imu(std::to_string(1700000000000LL + 10 * i)) + "\n";
+  InputOptions options;
+  options.max_errors = 10;
+  const std::string path = Write("ms.txt", text);
+  try {
+    ReadAll(path, options);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("too many damaged lines (11), last: absurd_value: "), std::string::npos) << what;
+    EXPECT_NE(what.find("(not seconds?)"), std::string::npos) << what;
+  }
+}
+
 TEST_F(LogReaderTest, LineLengthLimitIsExactAndCountsWithoutLineEnd) {
   InputOptions options;
   options.max_line_length = 40;

@@ -190,6 +190,7 @@ nlohmann::json RunSummary(const Options& options, const RunRequest& request, con
   if (session_stats.contains("warnings")) j["warnings"] = session_stats["warnings"];
   if (session_stats.contains("turn_rate_check")) j["input"]["turn_rate_check"] = session_stats["turn_rate_check"];
   if (session_stats.contains("heading_check")) j["input"]["heading_check"] = session_stats["heading_check"];
+  if (session_stats.contains("clock_check")) j["input"]["clock_check"] = session_stats["clock_check"];
   // Each estimator's verdict (solver/health.h), its outputs' dropped states included.
   for (const auto& [name, est] : j["estimators"].items()) {
     uint64_t non_finite = 0;

@@ -207,7 +207,10 @@ void Session::AddImu(const ImuSample& raw) {
     default:
       break;
   }
-  if (options_.vehicle.nonholonomic) turn_check_.AddImu(s.t, s.gyro, s.acc);
+  if (options_.vehicle.nonholonomic) {
+    turn_check_.AddImu(s.t, s.gyro, s.acc);
+    clock_check_.AddImu(s.t, s.acc);
+  }
   EnsureInitializer();
   if (!init_) {
     if (pending_imu_.size() < kMaxPending) {
@@ -360,6 +363,8 @@ void Session::AddGnss(const GnssRecord& g) {
     const double sigma_h = m.sigma_w.head<2>().norm() / std::sqrt(2.0);
     turn_check_.AddFix(m.t, m.p_w, sigma_h);
     if (turn_check_.outcome() == TurnRateCheck::Outcome::kRefuse) throw RunError(turn_check_.message());
+    clock_check_.AddFix(m.t, m.p_w, sigma_h);
+    if (clock_check_.outcome() == ClockOffsetCheck::Outcome::kRefuse) throw RunError(clock_check_.message());
     if (g.heading_valid && options_.gnss.use_heading) {
       heading_check_.AddFix(m.t, m.p_w, sigma_h, g.heading_deg, options_.gnss.mount_yaw);
       if (heading_check_.outcome() == HeadingCourseCheck::Outcome::kRefuse) throw RunError(heading_check_.message());
@@ -441,6 +446,8 @@ nlohmann::json Session::Stats() const {
                             {"course_per_gyro", turn_check_.slope()},
                             {"correlation", turn_check_.correlation()},
                             {"turned_deg", turn_check_.turned() * kRadToDeg}};
+    j["clock_check"] = {{"verdict", clock_check_.outcome() == ClockOffsetCheck::Outcome::kOk ? "ok" : "undecided"},
+                        {"correlation_at_0", clock_check_.Correlation(0)}};
     if (options_.gnss.use_heading) {
       j["heading_check"] = {
           {"verdict", heading_check_.outcome() == HeadingCourseCheck::Outcome::kOk ? "ok" : "undecided"}};

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/geodesy.h"
+#include "core/clock_checks.h"
 #include "core/imu_checks.h"
 #include "core/eval/gnss_outages.h"
 #include "core/measurements.h"
@@ -126,6 +127,7 @@ class Session {
   ImuAxesAndUnitsCheck imu_check_;
   TurnRateCheck turn_check_;  // for a car (vehicle.nonholonomic): the gyro against the GNSS track's turns
   HeadingCourseCheck heading_check_;  // and the dual-antenna heading against the track's course
+  ClockOffsetCheck clock_check_;      // and the track's accelerations against the IMU's, at whole-second lags
   std::string imu_warning_;
 
   // Standstill detection (core/standstill_detector.h), fed from the initialiser's start; after

@@ -171,7 +171,8 @@ void HeadingCourseCheck::AddFix(double t, const Vec3& p_w, double sigma_h, doubl
   have_course_ = true;
   last_course_ = course;
   const auto offset = [&](double scale) {
-    const double yaw = MeanYaw(CompassDegToEnuYaw(scale * anchor_.heading_deg), CompassDegToEnuYaw(scale * heading_deg));
+    const double yaw =
+        MeanYaw(CompassDegToEnuYaw(scale * anchor_.heading_deg), CompassDegToEnuYaw(scale * heading_deg));
     return WrapAngle(yaw - mount_yaw - course);
   };
   d_deg_.push_back(offset(1.0));

@@ -86,7 +86,8 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   const Vec3 g_w = gravity();
   const Vec3& rate_w = earth_.rate_w();
   const Vec3 omega = gap ? Vec3(nom_.x.q_wb.conjugate() * rate_w) : Vec3(held->gyro - nom_.x.bg);
-  const Vec3 acc = gap ? Vec3(nom_.x.q_wb.conjugate() * (2.0 * rate_w.cross(nom_.x.v_w) - g_w)) : Vec3(held->acc - nom_.x.ba);
+  const Vec3 acc =
+      gap ? Vec3(nom_.x.q_wb.conjugate() * (2.0 * rate_w.cross(nom_.x.v_w) - g_w)) : Vec3(held->acc - nom_.x.ba);
   // The covariance steps per sample, or over intervals of several (FlushCovariance), never across a gap.
   const bool per_sample = gap || options_.eskf.covariance_interval <= 0.0;
   if (gap) FlushCovariance();
@@ -211,7 +212,9 @@ void Eskf::AddRandomWalks(double dt) {
   if (options_.wheel.enabled && options_.wheel.estimate_scale) {
     P_(eskf::kS, eskf::kS) += options_.wheel.scale_rw * options_.wheel.scale_rw * dt;
   }
-  if (options_.gnss.estimate_time_offset) P_(kTd, kTd) += options_.gnss.time_offset_rw * options_.gnss.time_offset_rw * dt;
+  if (options_.gnss.estimate_time_offset) {
+    P_(kTd, kTd) += options_.gnss.time_offset_rw * options_.gnss.time_offset_rw * dt;
+  }
 }
 
 void Eskf::AddImu(const ImuSample& imu) {
@@ -389,7 +392,8 @@ nlohmann::json Eskf::Stats() const {
                       {"final_sigma_s", std::sqrt(std::max(P_(kTd, kTd), 0.0))}};
   const Vec3 g_w = gravity();
   j["final_gravity"] = {g_w.x(), g_w.y(), g_w.z()};
-  j["final_gyro_bias_deg_h"] = {nom_.x.bg.x() * kRadToDeg * 3600, nom_.x.bg.y() * kRadToDeg * 3600, nom_.x.bg.z() * kRadToDeg * 3600};
+  j["final_gyro_bias_deg_h"] = {nom_.x.bg.x() * kRadToDeg * 3600, nom_.x.bg.y() * kRadToDeg * 3600,
+                                nom_.x.bg.z() * kRadToDeg * 3600};
   j["final_acc_bias_m_s2"] = {nom_.x.ba.x(), nom_.x.ba.y(), nom_.x.ba.z()};
   if (rts_) j["rts"] = rts_->Stats();
   return j;

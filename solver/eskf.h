@@ -1,18 +1,19 @@
-// Error-state Kalman filter (reference ch. 3). Nominal state: NavState, gravity g_w, odometer scale s.
-// Error state (19): δp, δv, δθ, δbg, δba, δg, δs — right perturbation (DESIGN §2), so the first 15 are
-// the NavState tangent; the layout is declared once in solver/eskf_state.h. Prediction at IMU rate through
-// the shared kernel (core/imu_kernel.h); updates linearise the shared measurement models (core/*_model.h)
-// with core/linearize.h and all go through one update (Eskf::Update, solver/eskf_update.h): Jacobians per
-// block, a χ² innovation gate, an iterated update on the manifold (eskf.iterations, the IKFoM form: the
-// model is re-linearised at each iterate, the prior carried into its tangent), Joseph-form covariance, then
-// the reset with covariance projection.
+// Error-state Kalman filter (reference ch. 3). Nominal state: NavState, gravity g_w, odometer scale s, GNSS
+// time offset td. Error state (20): δp, δv, δθ, δbg, δba, δg, δs, δtd — right perturbation (DESIGN §2), so
+// the first 15 are the NavState tangent; the layout is declared once in solver/eskf_state.h. Prediction at
+// IMU rate through the shared kernel (core/imu_kernel.h); updates linearise the shared measurement models
+// (core/*_model.h) with core/linearize.h and all go through one update (Eskf::Update, solver/eskf_update.h):
+// Jacobians per block, a χ² innovation gate, an iterated update on the manifold (eskf.iterations, the IKFoM
+// form: the model is re-linearised at each iterate, the prior carried into its tangent), Joseph-form
+// covariance, then the reset with covariance projection.
 //
 // Measurements (solver/eskf_measurements.cc): GNSS position (lever arm) and dual-antenna heading, GNSS
-// velocity, wheel speed of the rear-axle centre at the middle of each record's interval (lever arm, every
-// record) and the left/right difference as a yaw-rate aid (wheel.track_m), the non-holonomic constraint at
-// vehicle.nhc_rate_hz whether or not the log has wheels, standstill updates. A run of rejected GNSS fixes
-// that agree with one another inflates the gate and, when a fix is accepted under it, the covariance it
-// updates (GateInflation, solver/estimator.h): re-acquisition after an outage by design.
+// velocity (each compared with the state at its stamp less td, core/time_shift.h; td is held at 0 unless
+// gnss.time_offset_s: estimate), wheel speed of the rear-axle centre at the middle of each record's interval
+// (lever arm, every record) and the left/right difference as a yaw-rate aid (wheel.track_m), the
+// non-holonomic constraint at vehicle.nhc_rate_hz whether or not the log has wheels, standstill updates. A
+// run of rejected GNSS fixes that agree with one another inflates the gate and, when a fix is accepted under
+// it, the covariance it updates (GateInflation, solver/estimator.h): re-acquisition after an outage by design.
 //
 // Robustness (config standstill.*, watchdog.*, imu.max_gap_s):
 // - Standstill (AddStandstill, from the session's detector): zero-velocity update (σ standstill.velocity_
@@ -134,7 +135,7 @@ class Eskf : public Estimator {
   PreInitOutput pre_init_{BridgeNoise{options_.imu.gyro_noise_density, options_.imu.acc_noise_density}};
   std::unique_ptr<EskfRts> rts_;  // with on_rts_
   bool initialized_ = false;
-  EskfNominal nom_;  // the nominal state: nom_.x the NavState, then δg, the odometer scale (eskf_state.h)
+  EskfNominal nom_;  // the nominal state: nom_.x the NavState, then δg, the odometer scale, td (eskf_state.h)
   EarthModel earth_;
   MatP P_ = MatP::Identity();
   // The samples' steps since the covariance's last step (eskf.covariance_interval_s): P_ is as of their

@@ -70,8 +70,9 @@ bool Eskf::UpdateGnssPosition(const GnssMeasurement& m) {
     Linearize<3, 10>(
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
-          const ShiftedKinematics<T> k = ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, d.template head<3>(), d.template segment<3>(3),
-                                                    d.template segment<3>(6), d[9]);
+          const ShiftedKinematics<T> k =
+              ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, d.template head<3>(),
+                              d.template segment<3>(3), d.template segment<3>(6), d[9]);
           return GnssPositionModel::Residual<T>(k.p_wb, k.q_wb, options_.gnss.lever_b, m.p_w);
         },
         &r, &H);
@@ -103,7 +104,8 @@ void Eskf::UpdateHeading(const GnssMeasurement& m) {
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
           const Eigen::Matrix<T, 3, 1> zero = Eigen::Matrix<T, 3, 1>::Zero();
-          const ShiftedKinematics<T> k = ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, zero, d.template head<3>(), zero, d[3]);
+          const ShiftedKinematics<T> k =
+              ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, zero, d.template head<3>(), zero, d[3]);
           return Eigen::Matrix<T, 1, 1>(HeadingModel::Residual<T>(k.q_wb, options_.gnss.mount_yaw, m.yaw_G));
         },
         &r, &H);
@@ -123,8 +125,9 @@ void Eskf::AddGvel(const GvelMeasurement& m) {
     Linearize<3, 7>(
         [&](const auto& d) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
-          const ShiftedKinematics<T> k = ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, Eigen::Matrix<T, 3, 1>::Zero(), d.template segment<3>(3),
-                                                    d.template head<3>(), d[6]);
+          const ShiftedKinematics<T> k =
+              ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, Eigen::Matrix<T, 3, 1>::Zero(),
+                              d.template segment<3>(3), d.template head<3>(), d[6]);
           return GnssVelocityModel::Residual<T>(k.q_wb, k.v_w, omega_b, options_.gnss.lever_b, m.v_w);
         },
         &r, &H);
@@ -187,7 +190,8 @@ void Eskf::UpdateWheelYawRate(const WheelMeasurement& m) {
   };
   // The gyro's own noise over the interval adds to the wheels'.
   const double gyro_var = std::pow(options_.imu.gyro_noise_density, 2) / m.interval;
-  const double var = m.yaw_rate_sigma * m.yaw_rate_sigma + nom_.Scalar<Block::kS>() * nom_.Scalar<Block::kS>() * gyro_var;
+  const double var =
+      m.yaw_rate_sigma * m.yaw_rate_sigma + nom_.Scalar<Block::kS>() * nom_.Scalar<Block::kS>() * gyro_var;
   Update<1>(model, Eigen::Matrix<double, 1, 1>(var), gate_wheel_yaw_, &wheel_yaw_counts_, m.t);
 }
 

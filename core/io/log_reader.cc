@@ -154,7 +154,8 @@ void LogReader::Impl::Accept(LogRecord* record, uint64_t line) {
   // Within the reorder window a record may be older than the newest one.
   newest_t_ = have_newest_ ? std::max(newest_t_, record->t()) : record->t();
   have_newest_ = true;
-  last_t_[k] = record->t();  // its own time: a record read ahead of the others (reorder window) is no duplicate of theirs
+  // Its own time: a record read ahead of the others (reorder window) is no duplicate of theirs.
+  last_t_[k] = record->t();
   have_last_[k] = true;
   record->line = line;
   switch (record->type) {

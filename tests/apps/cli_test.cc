@@ -13,9 +13,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <random>
-#include <iterator>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -66,6 +67,34 @@ std::vector<std::string> Lines(const std::string& text) {
   std::string line;
   while (std::getline(in, line)) lines.push_back(line);
   return lines;
+}
+
+// The log's text with each line passed through `edit`, which may change it, or return false to drop it.
+std::string EditLines(const std::string& text, const std::function<bool(std::string*)>& edit) {
+  std::string out;
+  for (std::string line : Lines(text)) {
+    if (edit(&line)) out += line + "\n";
+  }
+  return out;
+}
+
+// The same for the GNSS records, by their whitespace-separated fields (f[0] "GNSS", f[1] t, f[2] lat, ...).
+std::string EditGnssFields(const std::string& text, const std::function<void(std::vector<std::string>*)>& edit) {
+  return EditLines(text, [&](std::string* line) {
+    if (line->rfind("GNSS ", 0) != 0) return true;
+    std::istringstream in(*line);
+    std::vector<std::string> f{std::istream_iterator<std::string>(in), std::istream_iterator<std::string>()};
+    edit(&f);
+    line->clear();
+    for (const std::string& x : f) *line += (line->empty() ? "" : " ") + x;
+    return true;
+  });
+}
+
+std::string Fixed(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
+  return buf;
 }
 
 size_t FilesIn(const std::string& dir) {
@@ -283,22 +312,19 @@ TEST_F(CliRun, RunBoth) {
   EXPECT_GT(s["timing"]["real_time_factor"].get<double>(), 0.0);
 }
 
-// Issue 15's reproduction on the suite's drive: the IMU records of the 1.5 s right after the initialisation
-// removed (a loose connector). The run ends (it aborted: an IMU factor over an empty preintegration), every
+// A reported crash reproduced on the suite's drive: the IMU records of the 1.5 s right after the
+// initialisation removed (a loose connector). The run ends (it aborted: an IMU factor over an empty preintegration), every
 // state is finite, the outputs go on after the dropout, and summary.json counts the gap under "faults".
 TEST_F(CliRun, ImuDropoutRightAfterTheInitialisationRunsToTheEnd) {
   ASSERT_EQ(sim_exit_, 0);
   const std::string ref = dir_ + "/out_dropout_ref";
   ASSERT_EQ(RunCliInChild({"run", "--config", config_, "--log", log_, "--out", ref, "--mode", "eskf"}), 0);
   const double t_init = Summary(ref)["initialization"]["time"].get<double>();
-  std::string edited;
-  for (const std::string& line : Lines(test::ReadFile(log_))) {
-    if (line.rfind("IMU ", 0) == 0) {
-      const double t = std::stod(line.substr(4));
-      if (t > t_init && t <= t_init + 1.5) continue;
-    }
-    edited += line + "\n";
-  }
+  const std::string edited = EditLines(test::ReadFile(log_), [&](std::string* line) {
+    if (line->rfind("IMU ", 0) != 0) return true;
+    const double t = std::stod(line->substr(4));
+    return !(t > t_init && t <= t_init + 1.5);
+  });
   const std::string log = dir_ + "/log_dropout.txt";
   test::WriteFile(log, edited);
   const std::string out = dir_ + "/out_dropout";
@@ -323,22 +349,9 @@ TEST_F(CliRun, StrictExitsThreeUnlessEveryEstimatorIsHealthy) {
   const nlohmann::json ok = Summary(clean);
   for (const char* name : {"eskf", "smoother"}) EXPECT_EQ(ok["health"][name]["verdict"], "ok") << ok["health"].dump();
   const double t_init = ok["initialization"]["time"].get<double>();
-  std::string edited;
-  for (const std::string& line : Lines(test::ReadFile(log_))) {
-    std::istringstream in(line);
-    std::string kind;
-    double t = 0.0, lat = 0.0;
-    in >> kind >> t >> lat;
-    if (kind == "GNSS" && t > t_init + 10.0) {
-      std::string rest;
-      std::getline(in, rest);
-      char buf[64];
-      std::snprintf(buf, sizeof(buf), "%.10f", lat + 30.0 / 111111.0);
-      edited += "GNSS " + line.substr(5, line.find(' ', 5) - 5) + " " + buf + rest + "\n";
-      continue;
-    }
-    edited += line + "\n";
-  }
+  const std::string edited = EditGnssFields(test::ReadFile(log_), [&](std::vector<std::string>* f) {
+    if (std::stod((*f)[1]) > t_init + 10.0) (*f)[2] = Fixed(std::stod((*f)[2]) + 30.0 / 111111.0, 10);
+  });
   const std::string log = dir_ + "/log_moved.txt";
   test::WriteFile(log, edited);
   const std::string out = dir_ + "/out_strict_moved";
@@ -407,17 +420,9 @@ TEST_F(CliRun, CrossStreamJitterRunsWithTheDefaultConfig) {
 // finds the 0.1 s within 5 ms (and 0 on the log stamped right) and the ESKF is as accurate as when stated.
 TEST_F(CliRun, AGnssTimeOffsetStatedOrEstimatedUndoesTheLatency) {
   ASSERT_EQ(sim_exit_, 0);
-  std::string late;
-  for (const std::string& line : Lines(test::ReadFile(log_))) {
-    if (line.rfind("GNSS ", 0) == 0) {
-      const size_t end = line.find(' ', 5);
-      char buf[32];
-      std::snprintf(buf, sizeof(buf), "%.6f", std::stod(line.substr(5, end - 5)) + 0.1);
-      late += "GNSS " + std::string(buf) + line.substr(end) + "\n";
-      continue;
-    }
-    late += line + "\n";
-  }
+  const std::string late = EditGnssFields(test::ReadFile(log_), [](std::vector<std::string>* f) {
+    (*f)[1] = Fixed(std::stod((*f)[1]) + 0.1, 6);
+  });
   const std::string log = dir_ + "/log_late.txt", offset_config = dir_ + "/offset.yaml",
                     estimate_config = dir_ + "/estimate.yaml";
   test::WriteFile(log, late);
@@ -561,22 +566,11 @@ TEST_F(CliRun, WrongImuUnitsOrAxesAreRefusedAndNamed) {
 // driven 20 courses, naming the column; the same log in degrees runs (the fixture's own runs).
 TEST_F(CliRun, HeadingInRadiansIsRefusedAndNamed) {
   ASSERT_EQ(sim_exit_, 0);
-  std::string text;
   int converted = 0;
-  for (const std::string& line : Lines(test::ReadFile(log_))) {
-    std::istringstream in(line);
-    std::vector<std::string> f{std::istream_iterator<std::string>(in), std::istream_iterator<std::string>()};
-    if (f.size() < 7 || f[0] != "GNSS") {
-      text += line + "\n";
-      continue;
-    }
-    char buf[32];
-    std::snprintf(buf, sizeof(buf), "%.6f", std::stod(f[5]) * kDegToRad);
-    f[5] = buf;
-    converted += f[6] == "1";
-    for (size_t i = 0; i < f.size(); ++i) text += (i ? " " : "") + f[i];
-    text += "\n";
-  }
+  const std::string text = EditGnssFields(test::ReadFile(log_), [&](std::vector<std::string>* f) {
+    (*f)[5] = Fixed(std::stod((*f)[5]) * kDegToRad, 6);
+    converted += (*f)[6] == "1";
+  });
   ASSERT_GT(converted, 30);
   const std::string log = dir_ + "/heading_rad.txt", out = dir_ + "/out_heading_rad";
   test::WriteFile(log, text);
@@ -592,21 +586,12 @@ TEST_F(CliRun, HeadingInRadiansIsRefusedAndNamed) {
 TEST_F(CliRun, LogThatNeverInitialisesWritesNothing) {
   ASSERT_EQ(sim_exit_, 0);
   // The simulated log with every GNSS heading invalid while init waits for one (init.wait_for_heading).
-  std::string text;
-  for (const auto& l : Lines(test::ReadFile(log_))) {
-    std::string line = l;
-    if (line.rfind("GNSS ", 0) == 0) {
-      std::istringstream in(line);
-      std::vector<std::string> f;
-      std::string w;
-      while (in >> w) f.push_back(w);
-      ASSERT_GE(f.size(), 7u);
-      f[6] = "0";  // heading_valid
-      line.clear();
-      for (const auto& x : f) line += (line.empty() ? "" : " ") + x;
-    }
-    text += line + "\n";
-  }
+  size_t short_lines = 0;
+  const std::string text = EditGnssFields(test::ReadFile(log_), [&](std::vector<std::string>* f) {
+    if (f->size() < 7) return void(++short_lines);
+    (*f)[6] = "0";  // heading_valid
+  });
+  ASSERT_EQ(short_lines, 0u);
   const std::string log = dir_ + "/no_heading.txt";
   test::WriteFile(log, text);
   const std::string out = dir_ + "/out_no_init", wait_config = dir_ + "/wait_for_heading.yaml";

@@ -24,14 +24,19 @@ StateEstimate RestAt(double t) {
   return s;
 }
 
-// A standstill [0, 10] s, then a fit from 10 s (yaw 30°) to 13 s (yaw 50°, 12 m east and 4 m north on),
-// without its IMU samples.
-InitResult TurnedInit() {
+// A standstill [0, 10] s, then a fit's window from 10 s to 13 s.
+InitResult StandstillThenFit() {
   InitResult init;
   init.start = "standstill";
   init.static_start = 0.0;
   init.static_end = 10.0;
   init.fit_start.t = 10.0;
+  return init;
+}
+
+// The fit from 10 s (yaw 30°) to 13 s (yaw 50°, 12 m east and 4 m north on), without its IMU samples.
+InitResult TurnedInit() {
+  InitResult init = StandstillThenFit();
   init.fit_start.p_wb = Vec3(100.0, 200.0, 5.0);
   init.fit_start.q_wb = QuatFromYaw(30.0 * kDegToRad);
   init.x0.t = 13.0;
@@ -44,11 +49,7 @@ InitResult TurnedInit() {
 // A standstill to 10 s, then 5 m/s east, level, on a flat Earth without rotation: the fit's window 10-13 s
 // with its 100 Hz IMU samples (specific force: gravity's reaction alone).
 InitResult StraightInit() {
-  InitResult init;
-  init.start = "standstill";
-  init.static_start = 0.0;
-  init.static_end = 10.0;
-  init.fit_start.t = 10.0;
+  InitResult init = StandstillThenFit();
   init.fit_start.v_w = Vec3(5.0, 0.0, 0.0);
   init.x0 = init.fit_start;
   init.x0.t = 13.0;

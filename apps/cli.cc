@@ -130,7 +130,8 @@ int RunCli(int argc, const char* const* argv) {
   run->add_option("--log", req.log_path, "Sensor log (plain or .gz)")->required();
   run->add_option("--out", req.out_dir, "Output directory (created if missing)")->required();
   run->add_option("--mode", req.mode, "Estimator")->check(CLI::IsMember(SupportedModes()))->capture_default_str();
-  run->add_option("--truth", truth_path, "Truth CSV (DESIGN §5) for an accuracy summary")->check(CLI::ExistingFile);
+  run->add_option("--truth", truth_path, "Truth CSV (docs/formats.md §4) for an accuracy summary")
+      ->check(CLI::ExistingFile);
   bool strict = false;
   run->add_flag("--strict", strict,
                 "Exit 3 unless every estimator's health verdict is ok (degraded or failed: summary.json's health)");

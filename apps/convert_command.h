@@ -1,4 +1,4 @@
-// `gins convert`: turns logs in other formats into a gins log (DESIGN §3). The conversion itself is in the
+// `gins convert`: turns logs in other formats into a gins log (docs/formats.md §3). The conversion itself is in the
 // library (core/io/i2nav.h); this is the command line around it.
 #pragma once
 

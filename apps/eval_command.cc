@@ -349,7 +349,7 @@ CLI::App* AddEvalCommand(CLI::App& app, EvalRequest* req) {
                    "Trajectories: our .tum or *_states.csv (with the origin comment; .gz too), foreign TUM, or run "
                    "directories (their outputs and summary.json)")
       ->required();
-  eval->add_option("--truth", req->truth_path, "Truth CSV (DESIGN §5; .gz too)")->check(CLI::ExistingFile);
+  eval->add_option("--truth", req->truth_path, "Truth CSV (docs/formats.md §4; .gz too)")->check(CLI::ExistingFile);
   eval->add_option("--summary", req->summary_path,
                    "A run's summary.json: score the drift over its GNSS outages (simulated and log gaps)")
       ->check(CLI::ExistingFile);

@@ -1,4 +1,4 @@
-// `gins eval`: accuracy of trajectories against a truth (DESIGN §5), or of estimates against each other,
+// `gins eval`: accuracy of trajectories against a truth (docs/formats.md §4), or of estimates against each other,
 // with the metrics of core/trajectory_metrics.h: a table on stdout, everything as JSON with --json.
 #pragma once
 

@@ -1,7 +1,7 @@
 // The residuals of the alignment fit (core/alignment.h), each written once as a template on the scalar, from
 // the shared measurement models. All of them take the one 15-vector the fit estimates, the navigation state
 // at the window's first epoch t0 in NavState tangent order,
-//   x = (p_wb, v_w, δθ, bg, ba),   R_wb(t0) = R_ref·Exp(δθ)   (right perturbation about a reference, DESIGN §2),
+//   x = (p_wb, v_w, δθ, bg, ba),   R_wb(t0) = R_ref·Exp(δθ)   (right perturbation, core/conventions.h),
 // and predict the state at a measurement's epoch through the preintegrated IMU from t0 (PreintSnapshot,
 // PredictKinematics with the Earth terms). Residuals are whitened (divided by their 1-σ).
 #pragma once

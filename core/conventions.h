@@ -1,4 +1,4 @@
-// The conventions every part of gins shares. Fixed here, once (DESIGN.md §2).
+// The conventions every part of gins shares. Fixed here, once (for users: docs/formats.md §2).
 //
 // Frames
 //   w  world: local East-North-Up tangent plane at a geodetic origin (GeographicLib LocalCartesian).

@@ -1,4 +1,4 @@
-// The Earth as the estimators see it from the working frame w (DESIGN §2): w is the East-North-Up tangent
+// The Earth as the estimators see it from the working frame w (core/conventions.h): w is the East-North-Up tangent
 // frame at a geodetic origin, fixed to the Earth, so it turns with the Earth against inertial space.
 //
 // With the rotating model (gravity.earth_rotation: true, the default):

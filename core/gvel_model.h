@@ -1,5 +1,5 @@
 // GNSS (Doppler) velocity model: the antenna's velocity in w against the measured one (GVEL records,
-// DESIGN §3). The antenna sits at lever_b; ω_b is the body rate (gyro less bias):
+// docs/formats.md §3.5). The antenna sits at lever_b; ω_b is the body rate (gyro less bias):
 //   r = v_w + R_wb·(ω_b × lever_b) − z_w        (m/s, world ENU; 3)
 #pragma once
 

@@ -9,7 +9,7 @@
 // ω_ie is constant in w), the acceleration gains the Coriolis term and w turns under the body:
 //   both accelerations gain −2·ω_ie×v, φ is the turn against w, (ω − Rᵀω_ie)·dt, in the rotated specific
 //   force (not in R'), and R' = Exp(−ω_ie·dt)·R·Exp(ω·dt).
-// Error state (right perturbation, DESIGN §2), order δp, δv, δθ:
+// Error state (right perturbation, core/conventions.h), order δp, δv, δθ:
 //   δx' = A·δx + B·[δbg; δba] + B·[ηg; ηa] + G·δg
 // where ηg, ηa are the sensor white noises over the interval (rad/s, m/s²; discrete variance σ²/dt for
 // continuous densities σ), which enter exactly where the biases do.

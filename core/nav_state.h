@@ -1,4 +1,4 @@
-// NavState: the navigation state as a value type, with the right-perturbation ⊞/⊟ of DESIGN §2.
+// NavState: the navigation state as a value type, with the right-perturbation ⊞/⊟ of core/conventions.h.
 // Tangent order (15): δp, δv, δθ, δbg, δba — the first 15 of the ESKF error state.
 #pragma once
 

@@ -1,11 +1,11 @@
 // The AutoDiffCostFunction instantiations of the small factors, kept in one translation unit so the
 // Jet templates compile once (the IMU factor's lives in imu_factor.cc).
 //
-// The CHECKs below are programmer errors, not data (issue 15's audit): every σ comes from the config (checked
-// > 0 by config_keys.h) or from a record the reader accepted (σ > 0 and finite, log_limits); a preintegration
-// is attached only when it spans a positive time (Smoother::AnchorAt makes a keyframe instead, and
-// Smoother::IntegrateTo coasts where no sample covers a step); chord and random-walk intervals are between
-// keyframes, which are more than kSameEpoch apart.
+// The CHECKs below are programmer errors, not data (the audit of README "Faults in the stream"): every σ
+// comes from the config (checked > 0 by config_keys.h) or from a record the reader accepted (σ > 0 and
+// finite, log_limits); a preintegration is attached only when it spans a positive time (Smoother::AnchorAt
+// makes a keyframe instead, and Smoother::IntegrateTo coasts where no sample covers a step); chord and
+// random-walk intervals are between keyframes, which are more than kSameEpoch apart.
 #include <ceres/autodiff_cost_function.h>
 #include <glog/logging.h>
 

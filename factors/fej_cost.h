@@ -1,4 +1,4 @@
-// First-estimate Jacobians (DESIGN §7): a cost function that wraps another so that its Jacobians are
+// First-estimate Jacobians: a cost function that wraps another so that its Jacobians are
 // evaluated at the first estimates of the parameter blocks that have an active one, while its residual is
 // always evaluated at the current values. Once a marginalisation prior is built on a block, every other
 // factor on it must linearise where the prior did, so that the prior and the factors agree on what is

@@ -1,4 +1,4 @@
-// Manifold of a pose parameter block, with the right perturbation of DESIGN §2.
+// Manifold of a pose parameter block, with the right perturbation of core/conventions.h.
 //
 // Block layout (7 doubles):  [ p_wb.x, p_wb.y, p_wb.z,  q_wb.x, q_wb.y, q_wb.z, q_wb.w ]
 //   p_wb: body origin in w (m);  q_wb: Hamilton unit quaternion in Eigen storage order (x, y, z, w).

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Independent accuracy check of a gins trajectory against a truth file (DESIGN §5).
+"""Independent accuracy check of a gins trajectory against a truth file (docs/formats.md §4).
 
 Written apart from the C++ evaluation (numpy + GeographicLib-free ENU maths) so the two can check each
 other. Reports whole-run metrics, metrics outside GNSS outages (found from the log's GNSS time gaps, each

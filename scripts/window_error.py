@@ -3,7 +3,7 @@
 
 usage: window_error.py --truth truth.csv[.gz] --from T0 --to T1 TRAJ.tum [TRAJ.tum ...]
 Positions are compared at the truth's sample times (trajectory interpolated linearly), in the local ENU frame
-of the trajectory's origin_lla header (DESIGN §4, §5). numpy only.
+of the trajectory's origin_lla header (docs/formats.md §5.2, §4). numpy only.
 """
 import argparse
 import math

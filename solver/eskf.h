@@ -1,5 +1,5 @@
 // Error-state Kalman filter (reference ch. 3). Nominal state: NavState, gravity g_w, odometer scale s, GNSS
-// time offset td. Error state (20): δp, δv, δθ, δbg, δba, δg, δs, δtd — right perturbation (DESIGN §2), so
+// time offset td. Error state (20): δp, δv, δθ, δbg, δba, δg, δs, δtd — right perturbation (core/conventions.h), so
 // the first 15 are the NavState tangent; the layout is declared once in solver/eskf_state.h. Prediction at
 // IMU rate through the shared kernel (core/imu_kernel.h); updates linearise the shared measurement models
 // (core/*_model.h) with core/linearize.h and all go through one update (Eskf::Update, solver/eskf_update.h):

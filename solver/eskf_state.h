@@ -35,7 +35,7 @@ inline constexpr int kNumBlocks = static_cast<int>(Block::kCount);
 inline constexpr std::array<BlockInfo, kNumBlocks> kBlocks = {{
     {Block::kP, "p", 3},          // position in w, m
     {Block::kV, "v", 3},          // velocity in w, m/s
-    {Block::kTheta, "theta", 3},  // attitude, right perturbation (DESIGN §2), rad
+    {Block::kTheta, "theta", 3},  // attitude, right perturbation (core/conventions.h), rad
     {Block::kBg, "bg", 3},        // gyro bias, rad/s
     {Block::kBa, "ba", 3},        // accelerometer bias, m/s²
     {Block::kG, "g", 3},          // gravity in w, m/s²

@@ -1,4 +1,4 @@
-// Marginalisation of blocks out of the smoother's problem (DESIGN §7): the Schur complement of every
+// Marginalisation of blocks out of the smoother's problem: the Schur complement of every
 // residual that touches them (factors/marginalization_prior.h) becomes a prior on the blocks those residuals
 // also touch; then the residuals, the blocks and the prior change places in the problem.
 //

@@ -1,4 +1,4 @@
-// Sliding-window smoother (reference ch. 4, DESIGN §7): keyframes at GNSS epochs at least
+// Sliding-window smoother (reference ch. 4, docs/formats.md §7): keyframes at GNSS epochs at least
 // smoother.min_keyframe_interval_s apart (and every smoother.max_keyframe_interval_s without GNSS), each with
 // pose (7), velocity (3), biases (6) and the odometer scale (1) (solver/keyframe.h); IMU preintegration,
 // bias and scale random-walk factors between them; the measurements through their attachers

@@ -1,5 +1,5 @@
 // Conversion of the i2Nav (Wuhan University) text formats, read by KF-GINS and OB_GINS, into a gins log
-// (DESIGN §3), in one streaming pass over both files (bounded memory).
+// (docs/formats.md §3), in one streaming pass over both files (bounded memory).
 //
 // The formats, as published by i2Nav (i2Nav-WHU/KF-GINS README §2.2 "Data format" and
 // src/fileio/{imufileloader,gnssfileloader,fileloader}.h/.cc; i2Nav-WHU/awesome-gins-datasets README §2-3;

@@ -1,6 +1,6 @@
-// Streaming reader of the gins log format (DESIGN §3): IMU / ODOM / GNSS lines, optional GNSS σ columns,
-// '#' comments, blank lines, CRLF, gzip (detected by magic bytes, not by name). Memory does not grow with
-// the log. Damage policy (InputOptions::on_error):
+// Streaming reader of the gins log format (docs/formats.md §3): IMU / ODOM / GNSS / GVEL lines, optional σ
+// columns, '#' comments, blank lines, CRLF, gzip (detected by magic bytes, not by name). Memory does not grow
+// with the log. Damage policy (InputOptions::on_error):
 //   skip (default): a damaged line is skipped and counted by reason, with its file:line kept for the
 //                   summary (the first few per reason); reading goes on.
 //   stop:           the first damaged line throws InputError naming file, line and reason.
@@ -87,7 +87,7 @@ struct LogRecord {
   double t() const;
 };
 
-// "IMU", "ODOM" or "GNSS": the record's type token.
+// "IMU", "ODOM", "GNSS" or "GVEL": the record's type token.
 const char* LogRecordTypeName(LogRecord::Type type);
 
 struct InputIssue {

@@ -1,4 +1,4 @@
-// Writes a gins log (DESIGN §3) completely or not at all (AtomicFile): plain text, or gzip when the path
+// Writes a gins log (docs/formats.md §3) completely or not at all (AtomicFile): plain text, or gzip when the path
 // ends in ".gz". Numbers are written in their shortest form that reads back to the same double, so a log
 // written here and read by LogReader holds exactly the values given.
 #pragma once

@@ -1,5 +1,5 @@
-// Reading trajectories back: our TUM files and state CSVs (DESIGN §4, plain or gzip), and foreign TUM
-// files (evo and others) without an origin. The counterpart of core/trajectory_writer.h.
+// Reading trajectories back: our TUM files and state CSVs (docs/formats.md §5, plain or gzip), and foreign TUM
+// files (evo and others) without an origin. The counterpart of core/io/trajectory_writer.h.
 #pragma once
 
 #include <memory>

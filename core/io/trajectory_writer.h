@@ -32,7 +32,7 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-// Comment line naming the mode and the world frame's origin (DESIGN §4).
+// Comment line naming the mode and the world frame's origin (docs/formats.md §5.2).
 std::string TrajectoryHeader(const std::string& mode, const GeodeticPoint& origin);
 
 // One line of each format (with its '\n') to any stream: the writers below and `gins stream`'s stdout

@@ -1,4 +1,4 @@
-// Reader of truth files (DESIGN §5): t,lat,lon,alt,qw,qx,qy,qz,ve,vn,vu, plain or gzip, row by row into the
+// Reader of truth files (docs/formats.md §4): t,lat,lon,alt,qw,qx,qy,qz,ve,vn,vu, plain or gzip, row by row into the
 // world frame.
 #pragma once
 

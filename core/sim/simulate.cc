@@ -36,7 +36,7 @@ void WriteLogHeader(const SimOptions& sim, const Simulator& simulator, AtomicFil
                                   sim.write_gnss_sigma ? " se sn su" : "", gvel ? " | GVEL t ve vn vu se sn su" : ""));
 }
 
-// A truth row (DESIGN §5): attitude and velocity in the local ENU frame at the row's point, which is w for
+// A truth row (docs/formats.md §4): attitude and velocity in the local ENU frame at the row's point, which is w for
 // the flat model (whose world has one vertical).
 void WriteTruthRow(const Simulator& simulator, const NavState& x, AtomicFile* truth) {
   const GeodeticPoint g = simulator.truth().frame().ToGeodetic(x.p_wb);

@@ -1,7 +1,7 @@
 // Seeded, reproducible vehicle simulator: `gins simulate` writes its output to files (Simulate), and the
 // end-to-end tests run the same drive in memory (Simulator).
 //
-// World: the local ENU frame w at sim.origin, fixed to the Earth (DESIGN §2). The vehicle drives in w (its
+// World: the local ENU frame w at sim.origin, fixed to the Earth (core/conventions.h). The vehicle drives in w (its
 // roads are the tangent plane at the origin tilted by the grades, so far from the origin they climb by
 // d²/2R: 2 m at 5 km); geodetic output (GNSS fixes, truth.csv) maps w through LocalEnuFrame(origin), the same
 // map gins uses to read it. Two Earth models (sim.earth_rotation):
@@ -28,7 +28,7 @@
 // between knots placed at every break of smoothness, so the truth is exact to round-off and independent
 // of gins's IMU kernel.
 //
-// Sensors (DESIGN §2 IMU model, §3 log format). Time stamps are start_time + k/rate, k = 0, 1, ... (wheel
+// Sensors (docs/formats.md §2.7 IMU model, §3 log format). Time stamps are start_time + k/rate, k = 0, 1, ... (wheel
 // from k = 1: pulses count over (t − Δt, t]); records in time order, ties IMU, ODOM, GNSS, GVEL.
 //   IMU   flat:     ω̃ = ω_b + bg + ηg,              ã = R_wbᵀ(a_w − g_w) + ba + ηa;
 //         rotating: ω̃ = ω_b + R_wbᵀω_ie^w + bg + ηg, ã = R_wbᵀ(a_w + 2ω_ie^w×v_w − g_w(p_wb)) + ba + ηa;
@@ -299,8 +299,8 @@ struct SimulationResult {
   double duration = 0.0;  // s, of the whole drive (from start_time, whatever log_start)
 };
 
-// Runs the drive and writes out_dir/log.txt (DESIGN §3, with a `# gins simulate seed=...` header) and
-// out_dir/truth.csv (DESIGN §5, one row per IMU record; attitude and velocity in the local ENU frame at the
+// Runs the drive and writes out_dir/log.txt (docs/formats.md §3, with a `# gins simulate seed=...` header) and
+// out_dir/truth.csv (docs/formats.md §4, one row per IMU record; attitude and velocity in the local ENU frame at the
 // row's point when rotating, in w when flat). out_dir is created if missing. Each file is written under a
 // temporary name and renamed into place when complete. Throws std::invalid_argument on invalid options and
 // std::runtime_error on I/O failure.

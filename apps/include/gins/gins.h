@@ -4,7 +4,7 @@
 // the C++17 standard library: no Eigen, no Ceres, none of gins's internals. `gins run` and `gins stream`
 // are built on it. docs/api.md has a usage example.
 //
-// Conventions, stated once (the project's DESIGN §2):
+// Conventions, stated once (in full: docs/formats.md §2):
 //   - World frame w: local East-North-Up tangent plane at the origin: gnss.origin if the config sets one,
 //     else the first usable GNSS fix.
 //   - Body frame b: the IMU frame after the config's imu.axes mapping, x forward, y left, z up (FLU).
@@ -57,7 +57,7 @@ class Error : public std::runtime_error {
   Kind kind_;
 };
 
-// --- Measurements, as logged (the log format of DESIGN §3, one struct per record type) --------------------
+// --- Measurements, as logged (the log format of docs/formats.md §3, one struct per type) --------------------
 
 struct Imu {  // IMU record
   double t = 0.0;
@@ -273,7 +273,7 @@ struct ReadCounts {
   uint64_t skipped = 0;                                      // damaged lines skipped (input.on_error: skip)
 };
 
-// A log in the gins format (DESIGN §3), with the damage policy of the config's input.* keys: damaged lines
+// A log in the gins format (docs/formats.md §3), with the damage policy of the config's input.* keys: damaged lines
 // are skipped and counted, or stop the read (Error(kInput) naming the file, line and reason).
 class LogReader {
  public:

@@ -140,7 +140,7 @@ TEST(SimEarth, NoiseFreeImuThroughKernelWithEarthRateFollowsTruth) {
   RecordProperty("without_earth_rate_max_p_m", test::Sig3(without.max_p));
 }
 
-// truth.csv gives attitude and velocity in the local ENU frame at each row's point (DESIGN §5): read back
+// truth.csv gives attitude and velocity in the local ENU frame at each row's point (docs/formats.md §4): read back
 // through TruthReader (which rotates them into w) they are the simulator's truth in w, to the file's
 // rounding, ~9 km from the origin where the local frame is turned 1.5 mrad from w.
 TEST(SimEarth, TruthFileReadsBackIntoWorld) {

@@ -21,10 +21,15 @@ constexpr double kMaxAcc = 10.0;  // m/s²
 
 void ClockOffsetCheck::AddImu(double t, const Vec3& acc_b) {
   if (outcome_ != Outcome::kPending || !std::isfinite(t) || !acc_b.allFinite()) return;
-  Bin& b = imu_[Second(t)];
-  b.sum += acc_b.x();
-  ++b.n;
-  while (imu_.size() > static_cast<size_t>(kKeep)) imu_.erase(imu_.begin());
+  // Samples come in time order: the map is touched once per second, the running bin the rest of the time.
+  const long long second = Second(t);
+  if (second != imu_second_ || imu_bin_ == nullptr) {
+    imu_bin_ = &imu_[second];
+    imu_second_ = second;
+    while (imu_.size() > static_cast<size_t>(kKeep) && imu_.begin()->first != second) imu_.erase(imu_.begin());
+  }
+  imu_bin_->sum += acc_b.x();
+  ++imu_bin_->n;
 }
 
 void ClockOffsetCheck::AddFix(double t, const Vec3& p_w, double sigma_h) {
@@ -60,26 +65,23 @@ double ClockOffsetCheck::Correlation(int lag) const { return CorrelationAndCount
 
 std::pair<double, size_t> ClockOffsetCheck::CorrelationAndCount(int lag) const {
   // Pairs (IMU second k, GNSS second k + lag): a GNSS stamped `lag` s late shows the IMU's second k at k + lag.
-  std::vector<double> a, g;
+  // Both maps are in key order: one walk, no allocation (Decide runs it for 121 lags every 10 s).
+  double sa = 0.0, sg = 0.0, saa = 0.0, sgg = 0.0, sag = 0.0;
+  size_t n = 0;
+  auto it = gnss_.begin();
   for (const auto& [k, bin] : imu_) {
-    const auto it = gnss_.find(k + lag);
-    if (it == gnss_.end() || bin.n == 0 || it->second.n == 0) continue;
-    a.push_back(bin.sum / bin.n);
-    g.push_back(it->second.sum / it->second.n);
+    while (it != gnss_.end() && it->first < k + lag) ++it;
+    if (it == gnss_.end()) break;
+    if (it->first != k + lag || bin.n == 0 || it->second.n == 0) continue;
+    const double a = bin.sum / bin.n, g = it->second.sum / it->second.n;
+    sa += a, sg += g, saa += a * a, sgg += g * g, sag += a * g;
+    ++n;
   }
-  const size_t n = a.size();
   if (n < static_cast<size_t>(kMinSeconds)) return {0.0, n};
-  double ma = 0.0, mg = 0.0;
-  for (size_t i = 0; i < n; ++i) ma += a[i], mg += g[i];
-  ma /= n, mg /= n;
-  double saa = 0.0, sgg = 0.0, sag = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    saa += (a[i] - ma) * (a[i] - ma);
-    sgg += (g[i] - mg) * (g[i] - mg);
-    sag += (a[i] - ma) * (g[i] - mg);
-  }
-  if (std::sqrt(sgg / n) < kMinAccStd || saa <= 0.0) return {0.0, n};  // not enough driving to say
-  return {sag / std::sqrt(saa * sgg), n};
+  const double cn = static_cast<double>(n);
+  const double vaa = saa - sa * sa / cn, vgg = sgg - sg * sg / cn, vag = sag - sa * sg / cn;
+  if (vgg <= 0.0 || std::sqrt(vgg / cn) < kMinAccStd || vaa <= 0.0) return {0.0, n};  // not enough driving to say
+  return {vag / std::sqrt(vaa * vgg), n};
 }
 
 void ClockOffsetCheck::Decide() {

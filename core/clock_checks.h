@@ -45,6 +45,8 @@ class ClockOffsetCheck {
     int n = 0;
   };
   std::map<long long, Bin> imu_, gnss_;  // per whole second of each stream's stamps (only the newest kept)
+  Bin* imu_bin_ = nullptr;                // the IMU's current second's bin (map nodes do not move)
+  long long imu_second_ = 0;
   bool have_fix_ = false, have_speed_ = false;
   double fix_t_ = 0.0, speed_t_ = 0.0, speed_ = 0.0;
   Vec3 fix_p_ = Vec3::Zero();

@@ -35,8 +35,9 @@ struct GnssOptions {
   double min_sigma = 0.005;                // gnss.min_sigma_m: floor for logged σ (a zero σ is not trusted)
   // gnss.time_offset_s: the GNSS records (fixes, headings, velocities) are stamped this much after the IMU
   // time at which they were measured (a receiver's latency into the logger). A number: gins takes t − offset.
-  // `estimate` (estimate_time_offset): the ESKF estimates the rest as a state (solver/eskf.h), from 0 with
-  // 1-σ time_offset_sigma and a random walk time_offset_rw; the smoothers take time_offset.
+  // `estimate` (estimate_time_offset): the ESKF (solver/eskf.h) and the smoothers (a keyframe block,
+  // solver/keyframe.h) estimate the rest as a state, from 0 with 1-σ time_offset_sigma and a random walk
+  // time_offset_rw.
   double time_offset = 0.0;
   bool estimate_time_offset = false;
   double time_offset_sigma = 0.1;  // gnss.time_offset_sigma_s

@@ -11,6 +11,7 @@
 
 #include "factors/bias_rw_factor.h"
 #include "factors/chord_factor.h"
+#include "factors/delayed_factor.h"
 #include "factors/gnss_factor.h"
 #include "factors/gnss_preint_factor.h"
 #include "factors/gvel_factor.h"
@@ -68,6 +69,15 @@ ceres::CostFunction* PreintAttachedFactor<Measurement>::CreateAutoDiff(std::shar
 template class PreintAttachedFactor<GnssAtTime>;
 template class PreintAttachedFactor<HeadingAtTime>;
 template class PreintAttachedFactor<GvelAtTime>;
+
+template <class Measurement>
+ceres::CostFunction* DelayedAtKeyframeFactor<Measurement>::Create(Delayed<Measurement> delayed) {
+  return new ceres::AutoDiffCostFunction<DelayedAtKeyframeFactor<Measurement>, Measurement::kResidualDim,
+                                         pose::kAmbient, 3, 1>(new DelayedAtKeyframeFactor<Measurement>(delayed));
+}
+template class DelayedAtKeyframeFactor<GnssAtTime>;
+template class DelayedAtKeyframeFactor<HeadingAtTime>;
+template class DelayedAtKeyframeFactor<GvelAtTime>;
 
 ceres::CostFunction* GnssPreintFactor::Create(std::shared_ptr<const Preintegration> preint,
                                               const ImuEarthTerms& earth, const Vec3& z_w, const Vec3& sigma_w,

@@ -1,8 +1,11 @@
 #include "factors/preint_attached_factor.h"
 
+#include <ceres/autodiff_cost_function.h>
 #include <ceres/jet.h>
+#include <glog/logging.h>
 
 #include "core/so3.h"
+#include "factors/delayed_factor.h"
 
 namespace gins {
 namespace {
@@ -40,21 +43,21 @@ Mat9x15 PredictionJacobian(const Preintegration& pre, const ImuEarthTerms& earth
   return J;
 }
 
-}  // namespace
-
-template <class Measurement>
-bool PreintAttachedCostFunction<Measurement>::Evaluate(double const* const* parameters, double* residuals,
-                                                       double** jacobians) const {
+// The measurement at the state predicted at its stamp t (kDelayed: at t − td, td the fourth block), its
+// Jacobians the prediction's times the measurement's own in (δp_t, δθ_t, δv_t[, td]) from Jets.
+template <class Measurement, bool kDelayed>
+bool EvaluateAttached(const PreintAttachedFactor<Measurement>& factor, const Vec3& a_w, const Vec3& omega_b,
+                      double const* const* parameters, double* residuals, double** jacobians) {
   constexpr int M = Measurement::kResidualDim;
+  constexpr int kJet = kDelayed ? 10 : 9;
   const double* pose_i = parameters[0];
   const Eigen::Map<const Vec3> p_i(pose_i + pose::kP), v_i(parameters[1]);
   const Eigen::Map<const Quat> q_i(pose_i + pose::kQ);
   const Eigen::Map<const Vec3> bg(parameters[2]), ba(parameters[2] + 3);
-  const Preintegration& pre = factor_.preintegration();
+  const Preintegration& pre = factor.preintegration();
   const PredictedKinematics<double> k = PredictKinematics<double>(
-      pre, factor_.earth(), factor_.turns(), Vec3(p_i), Quat(q_i), Vec3(v_i), Vec3(bg), Vec3(ba));
-  // The measurement at the predicted state, differentiated in (δp_t, δθ_t, δv_t) with Jets.
-  using Jet = ceres::Jet<double, 9>;
+      pre, factor.earth(), factor.turns(), Vec3(p_i), Quat(q_i), Vec3(v_i), Vec3(bg), Vec3(ba));
+  using Jet = ceres::Jet<double, kJet>;
   PredictedKinematics<Jet> kj;
   Eigen::Matrix<Jet, 3, 1> dtheta;
   for (int c = 0; c < 3; ++c) {
@@ -64,15 +67,20 @@ bool PreintAttachedCostFunction<Measurement>::Evaluate(double const* const* para
   }
   kj.q = k.q.cast<Jet>() * ExpQuat<Jet>(dtheta);
   Jet r[M];
-  factor_.measurement()(kj, r);
-  Eigen::Matrix<double, M, 9> J_meas;
+  if constexpr (kDelayed) {
+    Delayed<Measurement>{factor.measurement(), a_w, omega_b}(kj, Jet(parameters[3][0], 9), r);
+  } else {
+    factor.measurement()(kj, r);
+  }
+  Eigen::Matrix<double, M, kJet> J_meas;
   for (int i = 0; i < M; ++i) {
     residuals[i] = r[i].a;
     J_meas.row(i) = r[i].v.transpose();
   }
   if (jacobians == nullptr) return true;
+  const Eigen::Matrix<double, M, 9> J_state = J_meas.template leftCols<9>();
   const Eigen::Matrix<double, M, 15> J =
-      J_meas * PredictionJacobian(pre, factor_.earth(), factor_.turns(), Quat(q_i), Vec3(bg), Vec3(ba));
+      J_state * PredictionJacobian(pre, factor.earth(), factor.turns(), Quat(q_i), Vec3(bg), Vec3(ba));
   if (jacobians[0] != nullptr) {  // pose_i: tangent (δp, δθ) lifted to the ambient block
     WriteAmbientPoseJacobian<M>(J.template middleCols<3>(kColP), J.template middleCols<3>(kColTheta), Quat(q_i),
                                 jacobians[0]);
@@ -85,11 +93,72 @@ bool PreintAttachedCostFunction<Measurement>::Evaluate(double const* const* para
     Eigen::Map<Eigen::Matrix<double, M, 6, Eigen::RowMajor>> out(jacobians[2]);
     out = J.template middleCols<6>(kColBg);
   }
+  if constexpr (kDelayed) {
+    if (jacobians[3] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, M, 1>> out(jacobians[3]);
+      out = J_meas.template rightCols<1>();
+    }
+  }
   return true;
+}
+
+}  // namespace
+
+template <class Measurement>
+bool PreintAttachedCostFunction<Measurement>::Evaluate(double const* const* parameters, double* residuals,
+                                                       double** jacobians) const {
+  return EvaluateAttached<Measurement, false>(factor_, Vec3::Zero(), Vec3::Zero(), parameters, residuals,
+                                              jacobians);
+}
+
+template <class Measurement>
+bool DelayedAttachedCostFunction<Measurement>::Evaluate(double const* const* parameters, double* residuals,
+                                                        double** jacobians) const {
+  return EvaluateAttached<Measurement, true>(factor_, a_w_, omega_b_, parameters, residuals, jacobians);
+}
+
+namespace {
+// DelayedAttachedCostFunction's residual for autodiff: PredictKinematics, then the shift and the model.
+template <class Measurement>
+struct DelayedAttachedResidual {
+  PreintAttachedFactor<Measurement> factor;
+  Vec3 a_w, omega_b;
+  template <typename T>
+  bool operator()(const T* pose_i, const T* vel_i, const T* bias_i, const T* td, T* residual) const {
+    using Vec3T = Eigen::Matrix<T, 3, 1>;
+    const PredictedKinematics<T> k = PredictKinematics<T>(
+        factor.preintegration(), factor.earth(), factor.turns(), Vec3T(PosePosition(pose_i)),
+        Eigen::Quaternion<T>(PoseRotation(pose_i)), Eigen::Map<const Vec3T>(vel_i), Eigen::Map<const Vec3T>(bias_i),
+        Eigen::Map<const Vec3T>(bias_i + 3));
+    Delayed<Measurement>{factor.measurement(), a_w, omega_b}(k, td[0], residual);
+    return true;
+  }
+};
+}  // namespace
+
+template <class Measurement>
+ceres::CostFunction* DelayedAttachedCostFunction<Measurement>::Create(std::shared_ptr<const Preintegration> preint,
+                                                                      const ImuEarthTerms& earth,
+                                                                      Delayed<Measurement> delayed) {
+  CHECK(preint != nullptr && preint->dt() > 0.0) << "DelayedAttachedCostFunction over an empty preintegration";
+  return new DelayedAttachedCostFunction<Measurement>(std::move(preint), earth, std::move(delayed));
+}
+
+template <class Measurement>
+ceres::CostFunction* DelayedAttachedCostFunction<Measurement>::CreateAutoDiff(
+    std::shared_ptr<const Preintegration> preint, const ImuEarthTerms& earth, Delayed<Measurement> delayed) {
+  CHECK(preint != nullptr && preint->dt() > 0.0) << "DelayedAttachedCostFunction over an empty preintegration";
+  using Residual = DelayedAttachedResidual<Measurement>;
+  return new ceres::AutoDiffCostFunction<Residual, Measurement::kResidualDim, pose::kAmbient, 3, 6, 1>(
+      new Residual{PreintAttachedFactor<Measurement>(std::move(preint), earth, delayed.measurement), delayed.a_w,
+                   delayed.omega_b});
 }
 
 template class PreintAttachedCostFunction<GnssAtTime>;
 template class PreintAttachedCostFunction<HeadingAtTime>;
 template class PreintAttachedCostFunction<GvelAtTime>;
+template class DelayedAttachedCostFunction<GnssAtTime>;
+template class DelayedAttachedCostFunction<HeadingAtTime>;
+template class DelayedAttachedCostFunction<GvelAtTime>;
 
 }  // namespace gins

@@ -1,4 +1,5 @@
-// Odometer scale random-walk factor between consecutive keyframes i and j.
+// Random-walk factor of a scalar block between consecutive keyframes i and j: the odometer scale, and the
+// GNSS time offset (σ_rw in s/√s there).
 //
 // Parameter blocks: scale_i (1, unitless), scale_j (1).
 // Residual (1):

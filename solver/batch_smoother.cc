@@ -246,8 +246,10 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
         if (inside(f)) spans.push_back(f);
       }
       if (prior.cost) spans.push_back({SIZE_MAX, prior.lo, prior.hi});
-      std::vector<Mat15> cov;
+      std::vector<MatX> cov;  // block order
       const bool ok = RecoverCovariances(&problem, spans, first, last, &cov);
+      std::vector<Mat15> nav_cov;
+      for (const MatX& c : cov) nav_cov.push_back(NavCovariance(types_, c));
       stats_.covariance_time_s += Seconds(std::chrono::steady_clock::now() - t1);
       // The window decided on each fix from one side; check them all again on the two-sided solution and
       // its covariance, and solve once more if a decision changed.
@@ -262,7 +264,7 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
       if (seam_from < last) {
         // Among the keyframes whose position variance is within 25 % of the best, the one nearest the middle
         // of the overlap (the most data on both sides).
-        const auto var = [&](int k) { return cov[k - first].block<3, 3>(nav::kP, nav::kP).trace(); };
+        const auto var = [&](int k) { return nav_cov[k - first].block<3, 3>(nav::kP, nav::kP).trace(); };
         const int middle = (seam_from + seam_to) / 2;
         seam = middle;
         if (ok) {
@@ -276,8 +278,9 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
         }
       }
       for (int k = first; ok && k < seam; ++k) {
-        covariances_[k] = cov[k - first];
+        covariances_[k] = nav_cov[k - first];
         have_cov_[k] = true;
+        if (k + 1 == static_cast<int>(kfs_.size())) last_block_cov_ = cov[k - first];
       }
       return seam;
     }
@@ -314,7 +317,7 @@ void BatchSmoother::SolveBeforeSeam(const FactorLog& log, int first, int seam, c
   ++stats_.solves;
 }
 
-bool BatchSmoother::Revisit(FactorLog* log, int first, int last, const std::vector<Mat15>& cov) {
+bool BatchSmoother::Revisit(FactorLog* log, int first, int last, const std::vector<MatX>& cov) {
   bool changed = false;
   for (const FactorSpan& f : factors_) {
     if (f.lo < first || f.hi >= last || f.lo != f.hi) continue;
@@ -328,15 +331,9 @@ bool BatchSmoother::Revisit(FactorLog* log, int first, int last, const std::vect
       kinds.push_back(SpecOf(ref.type).kind);
       types.push_back(ref.type);
     }
-    // The keyframe's covariance over the factor's blocks (their tangents in the factor's order).
-    const std::vector<int> nav = NavIndexOfTangent(types);
-    MatX sigma(nav.size(), nav.size());
-    bool in_nav = true;
-    for (size_t r = 0; r < nav.size(); ++r) {
-      in_nav = in_nav && nav[r] >= 0;
-      for (size_t c = 0; c < nav.size(); ++c) sigma(r, c) = nav[r] >= 0 && nav[c] >= 0 ? cov[f.lo - first](nav[r], nav[c]) : 0.0;
-    }
-    if (!in_nav) continue;
+    // The keyframe's covariance over the factor's blocks (their tangents in the factor's order; a block not
+    // estimated leaves it short, and CheckFactor refuses).
+    const MatX sigma = SubCovariance(types_, cov[f.lo - first], types);
     // A used measurement is part of the solution: its residual's covariance is R − HPHᵀ; an unused one is
     // predicted by it: R + HPHᵀ. The same χ² gate as the window's.
     const FactorCheck check = CheckFactor(*lf.cost, params, kinds, sigma, /*posterior=*/lf.active);
@@ -428,7 +425,7 @@ BatchSmoother::Prior BatchSmoother::MarginalPrior(const FactorLog& log, int firs
 }
 
 bool BatchSmoother::RecoverCovariances(ceres::Problem* problem, const std::vector<FactorSpan>& spans, int first,
-                                       int last, std::vector<Mat15>* cov) {
+                                       int last, std::vector<MatX>* cov) {
   const int n_kf = last - first;
   int w = 1;
   for (const FactorSpan& f : spans) w = std::max(w, f.hi - f.lo);
@@ -476,7 +473,7 @@ bool BatchSmoother::RecoverCovariances(ceres::Problem* problem, const std::vecto
       return false;
     }
   }
-  cov->assign(n_kf, Mat15::Zero());
+  cov->assign(n_kf, MatX::Zero(per, per));
   MatX sigma_next;
   for (int g = n_groups - 1; g >= 0; --g) {
     MatX sigma = S_inv[g];
@@ -486,11 +483,20 @@ bool BatchSmoother::RecoverCovariances(ceres::Problem* problem, const std::vecto
     }
     for (int k = g * w; k < std::min(n_kf, (g + 1) * w); ++k) {
       const int o = (k - g * w) * per;
-      (*cov)[k] = NavCovariance(types_, MatX(sigma.block(o, o, per, per)));
+      (*cov)[k] = sigma.block(o, o, per, per);
     }
     sigma_next = std::move(sigma);
   }
   return true;
+}
+
+nlohmann::json BatchSmoother::TimeOffset() const {
+  const double td = kfs_.empty() ? 0.0 : kfs_.back()->block(BlockType::kTimeOffset)[0];
+  double sigma = 0.0;
+  if (estimated_[static_cast<int>(BlockType::kTimeOffset)] && last_block_cov_.size() > 0) {
+    sigma = std::sqrt(std::max(SubCovariance(types_, last_block_cov_, {BlockType::kTimeOffset})(0, 0), 0.0));
+  }
+  return TimeOffsetJson(options_.gnss, td, sigma);
 }
 
 void BatchSmoother::Emit(const FactorLog& log, const EarthModel& earth, const StateCallback& out) const {

@@ -66,6 +66,8 @@ class BatchSmoother {
   void Emit(const FactorLog& log, const EarthModel& earth, const StateCallback& out) const;
 
   const BatchStats& stats() const { return stats_; }
+  // summary.json's "time_offset" (solver/estimator.h): the newest keyframe's, with its σ from the solution.
+  nlohmann::json TimeOffset() const;
 
  private:
   // A logged factor and the keyframes (indices into kfs_) it spans.
@@ -86,15 +88,15 @@ class BatchSmoother {
   int SolveSegment(FactorLog* log, const EarthModel& earth, int first, int last, int seam_from, int seam_to,
                    const Prior& prior);
   // Checks every revisitable measurement of [first, last) against the solution and its covariance (per
-  // keyframe, NavState order); true if one changed sides.
-  bool Revisit(FactorLog* log, int first, int last, const std::vector<Mat15>& cov);
+  // keyframe, block order); true if one changed sides.
+  bool Revisit(FactorLog* log, int first, int last, const std::vector<MatX>& cov);
   // Solves keyframes [first, seam) again with those from the seam on held where the later segment put them.
   void SolveBeforeSeam(const FactorLog& log, int first, int seam, const Prior& prior);
   Prior MarginalPrior(const FactorLog& log, int first, int seam, const Prior& previous);
-  // The marginal covariance of each keyframe of [first, last) (NavState order); false if H is not positive
-  // definite or not banded.
+  // The marginal covariance of each keyframe of [first, last) (its estimated blocks' tangents, block order);
+  // false if H is not positive definite or not banded.
   bool RecoverCovariances(ceres::Problem* problem, const std::vector<FactorSpan>& spans, int first, int last,
-                          std::vector<Mat15>* cov);
+                          std::vector<MatX>* cov);
 
   EstimatorOptions options_;
   std::vector<BlockType> types_;
@@ -106,6 +108,7 @@ class BatchSmoother {
   std::vector<FactorSpan> factors_;
   std::vector<size_t> imu_factor_;  // per keyframe: its IMU factor's log index (SIZE_MAX: none)
   std::vector<Mat15> covariances_;
+  MatX last_block_cov_;  // the newest keyframe's, block order (empty: none)
   std::vector<bool> have_cov_;
   BatchStats stats_;
 };

@@ -399,9 +399,8 @@ nlohmann::json Eskf::Stats() const {
   j["zero_velocity"] = zupt_counts_.ToJson();
   j["final_odom_scale"] = nom_.Scalar<Block::kS>();
   // The GNSS time offset: the stated value plus the estimated part (gnss.time_offset_s).
-  j["time_offset"] = {{"estimated", options_.gnss.estimate_time_offset},
-                      {"final_s", options_.gnss.time_offset + nom_.Scalar<Block::kTd>()},
-                      {"final_sigma_s", std::sqrt(std::max(P_(kTd, kTd), 0.0))}};
+  j["time_offset"] =
+      TimeOffsetJson(options_.gnss, nom_.Scalar<Block::kTd>(), std::sqrt(std::max(P_(kTd, kTd), 0.0)));
   const Vec3 g_w = gravity();
   j["final_gravity"] = {g_w.x(), g_w.y(), g_w.z()};
   j["final_gyro_bias_deg_h"] = {nom_.x.bg.x() * kRadToDeg * 3600, nom_.x.bg.y() * kRadToDeg * 3600,

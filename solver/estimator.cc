@@ -228,4 +228,8 @@ nlohmann::json GnssWatchdog::ToJson() const {
   return {{"resets", resets}, {"count", count_}};
 }
 
+nlohmann::json TimeOffsetJson(const GnssOptions& gnss, double td, double sigma) {
+  return {{"estimated", gnss.estimate_time_offset}, {"final_s", gnss.time_offset + td}, {"final_sigma_s", sigma}};
+}
+
 }  // namespace gins

@@ -151,6 +151,10 @@ inline bool AcceleratingWithoutWitness(const StandstillMeasurement& m, const Nav
 Quat FallbackAttitude(const GnssMeasurement& m, const EstimatorOptions& options);
 Mat15 FallbackCovariance(const EstimatorOptions& options);
 
+// summary.json's "time_offset" of an estimator: whether it is estimated, the stated gnss.time_offset_s plus
+// the estimated part td (s), and td's 1-σ (0 when held).
+nlohmann::json TimeOffsetJson(const GnssOptions& gnss, double td, double sigma);
+
 // The watchdog's re-initialisation from a GNSS fix m, alike in both estimators: position from the fix
 // through the lever arm, velocity from the previous fix when it is recent (else kept), and both with a fresh
 // covariance, uncorrelated with the rest; the yaw variance is raised to at least (2°)², since a

@@ -16,6 +16,9 @@
 namespace gins {
 
 namespace keyframe_blocks {
+namespace {
+constexpr double kMinTimeOffsetRandomWalk = 1e-6;  // s/√s
+}  // namespace
 
 void PoseToNav(const double* values, NavState* x) {
   x->p_wb = Eigen::Map<const Vec3>(values + pose::kP);
@@ -44,6 +47,17 @@ ceres::CostFunction* BiasRandomWalk(const EstimatorOptions& options, double dt) 
 ceres::CostFunction* ScaleRandomWalk(const EstimatorOptions& options, double dt) {
   return ScaleRwFactor::Create(options.wheel.scale_rw, dt);
 }
+double ScaleRandomWalkSigma(const EstimatorOptions& options) { return options.wheel.scale_rw; }
+bool TimeOffsetEstimated(const EstimatorOptions& options) { return options.gnss.estimate_time_offset; }
+double TimeOffsetPriorSigma(const EstimatorOptions& options) { return options.gnss.time_offset_sigma; }
+// A random walk of 0 (allowed: a constant offset) would make the factor's weight infinite; this floor keeps
+// the offset constant to 0.1 ms over an hour.
+double TimeOffsetRandomWalkSigma(const EstimatorOptions& options) {
+  return std::max(options.gnss.time_offset_rw, kMinTimeOffsetRandomWalk);
+}
+ceres::CostFunction* TimeOffsetRandomWalk(const EstimatorOptions& options, double dt) {
+  return ScaleRwFactor::Create(TimeOffsetRandomWalkSigma(options), dt);  // a scalar random walk, as the scale's
+}
 
 }  // namespace keyframe_blocks
 
@@ -61,6 +75,8 @@ constexpr bool TableIsConsistent() {
     if (s.num_runs > 0 && covered != s.tangent_size) return false;
     if ((s.to_nav == nullptr) != (s.num_runs == 0) || (s.from_nav == nullptr) != (s.num_runs == 0)) return false;
     if (s.num_runs == 0 && s.prior_sigma == nullptr) return false;
+    // Outside NavState, a random walk states its σ (the predicted covariance's process noise).
+    if (s.num_runs == 0 && (s.random_walk == nullptr) != (s.random_walk_sigma == nullptr)) return false;
   }
   return true;
 }
@@ -161,7 +177,10 @@ std::unique_ptr<Keyframe> KeyframeStore::Make(double t, const NavState& x) const
   for (const BlockSpec& spec : kBlockSpecs) {
     if (spec.from_nav != nullptr) continue;
     double* b = kf->block(spec.type);
-    if (window_.empty()) {
+    if (window_.empty() && have_kept_) {
+      const double* kept = kept_ + AmbientOffset(spec.type);
+      std::copy(kept, kept + spec.ambient_size, b);
+    } else if (window_.empty()) {
       std::fill(b, b + spec.ambient_size, spec.initial_value);
     } else {
       const double* prev = back().block(spec.type);
@@ -169,6 +188,15 @@ std::unique_ptr<Keyframe> KeyframeStore::Make(double t, const NavState& x) const
     }
   }
   return kf;
+}
+
+void KeyframeStore::KeepValues(const Keyframe& kf) {
+  for (const BlockSpec& spec : kBlockSpecs) {
+    if (spec.from_nav != nullptr) continue;
+    const double* b = kf.block(spec.type);
+    std::copy(b, b + spec.ambient_size, kept_ + AmbientOffset(spec.type));
+  }
+  have_kept_ = true;
 }
 
 ceres::Manifold* KeyframeStore::ManifoldOf(const BlockSpec& spec) {
@@ -266,8 +294,7 @@ ceres::ResidualBlockId KeyframeStore::AddLogged(std::shared_ptr<ceres::CostFunct
   return problem_->AddResidualBlock(in_problem, loss, params);
 }
 
-ceres::ResidualBlockId KeyframeStore::AddPrior(Keyframe& kf, const Mat15& P0) {
-  // The covariance in the estimated blocks' tangent order; blocks outside NavState uncorrelated.
+MatX KeyframeStore::PriorCovariance(const Mat15& P0) const {
   const std::vector<BlockType> types = EstimatedTypes();
   const std::vector<int> nav = NavIndexOfTangent(types);
   const int n = static_cast<int>(nav.size());
@@ -286,6 +313,13 @@ ceres::ResidualBlockId KeyframeStore::AddPrior(Keyframe& kf, const Mat15& P0) {
     }
     column += spec.tangent_size;
   }
+  return P;
+}
+
+ceres::ResidualBlockId KeyframeStore::AddPrior(Keyframe& kf, const Mat15& P0) {
+  const std::vector<BlockType> types = EstimatedTypes();
+  const MatX P = PriorCovariance(P0);
+  const int n = static_cast<int>(P.rows());
   const MatX info = P.inverse();
   const Eigen::LLT<MatX> llt(0.5 * (info + info.transpose()));
   const MatX J = llt.matrixU();  // JᵀJ = info

@@ -25,8 +25,8 @@ namespace gins {
 
 // The state blocks of one keyframe, in table order (the order of kBlockSpecs, of Keyframe::values, of every
 // list of a keyframe's blocks, and so of the solver's elimination order).
-enum class BlockType { kPose, kVelocity, kBias, kScale };
-inline constexpr int kNumBlockTypes = 4;
+enum class BlockType { kPose, kVelocity, kBias, kScale, kTimeOffset };
+inline constexpr int kNumBlockTypes = 5;
 
 // Coordinates [tangent_offset, tangent_offset + size) of a block's tangent sit at
 // [nav_offset, nav_offset + size) of the NavState tangent.
@@ -59,6 +59,8 @@ struct BlockSpec {
   // The factor between this block of two consecutive keyframes dt apart, when it is a random walk; null
   // for a block the IMU factor links (pose, velocity).
   ceres::CostFunction* (*random_walk)(const EstimatorOptions& options, double dt);
+  // For a random walk outside NavState: its 1-σ per √s, for the window's predicted covariance.
+  double (*random_walk_sigma)(const EstimatorOptions& options);
 };
 
 namespace keyframe_blocks {
@@ -71,8 +73,14 @@ void BiasFromNav(const NavState& x, double* values);
 // The odometer scale is estimated only with wheels and wheel.estimate_scale.
 bool ScaleEstimated(const EstimatorOptions& options);
 double ScalePriorSigma(const EstimatorOptions& options);
+double ScaleRandomWalkSigma(const EstimatorOptions& options);
 ceres::CostFunction* BiasRandomWalk(const EstimatorOptions& options, double dt);
 ceres::CostFunction* ScaleRandomWalk(const EstimatorOptions& options, double dt);
+// The GNSS time offset beyond gnss.time_offset_s (s; factors/delayed_factor.h), with `estimate` only.
+bool TimeOffsetEstimated(const EstimatorOptions& options);
+double TimeOffsetPriorSigma(const EstimatorOptions& options);
+double TimeOffsetRandomWalkSigma(const EstimatorOptions& options);
+ceres::CostFunction* TimeOffsetRandomWalk(const EstimatorOptions& options, double dt);
 }  // namespace keyframe_blocks
 
 // clang-format off
@@ -80,19 +88,25 @@ inline constexpr std::array<BlockSpec, kNumBlockTypes> kBlockSpecs = {{
     {BlockType::kPose, "pose", pose::kAmbient, pose::kTangent, BlockKind::kPose,
      2, {{{pose::kP, nav::kP, 3}, {pose::kTheta, nav::kTheta, 3}}},
      &keyframe_blocks::PoseToNav, &keyframe_blocks::PoseFromNav,
-     nullptr, 0.0, nullptr, nullptr},
+     nullptr, 0.0, nullptr, nullptr, nullptr},
     {BlockType::kVelocity, "velocity", 3, 3, BlockKind::kEuclidean,
      1, {{{0, nav::kV, 3}, {}}},
      &keyframe_blocks::VelocityToNav, &keyframe_blocks::VelocityFromNav,
-     nullptr, 0.0, nullptr, nullptr},
+     nullptr, 0.0, nullptr, nullptr, nullptr},
     {BlockType::kBias, "bias", 6, 6, BlockKind::kEuclidean,
      1, {{{0, nav::kBg, 6}, {}}},  // (bg, ba): contiguous in NavState too
      &keyframe_blocks::BiasToNav, &keyframe_blocks::BiasFromNav,
-     nullptr, 0.0, nullptr, &keyframe_blocks::BiasRandomWalk},
+     nullptr, 0.0, nullptr, &keyframe_blocks::BiasRandomWalk, nullptr},
     {BlockType::kScale, "scale", 1, 1, BlockKind::kEuclidean,
      0, {},
      nullptr, nullptr,
-     &keyframe_blocks::ScaleEstimated, 1.0, &keyframe_blocks::ScalePriorSigma, &keyframe_blocks::ScaleRandomWalk},
+     &keyframe_blocks::ScaleEstimated, 1.0, &keyframe_blocks::ScalePriorSigma, &keyframe_blocks::ScaleRandomWalk,
+     &keyframe_blocks::ScaleRandomWalkSigma},
+    {BlockType::kTimeOffset, "time_offset", 1, 1, BlockKind::kEuclidean,
+     0, {},
+     nullptr, nullptr,
+     &keyframe_blocks::TimeOffsetEstimated, 0.0, &keyframe_blocks::TimeOffsetPriorSigma,
+     &keyframe_blocks::TimeOffsetRandomWalk, &keyframe_blocks::TimeOffsetRandomWalkSigma},
 }};
 // clang-format on
 
@@ -182,9 +196,13 @@ class KeyframeStore {
   ceres::Problem* problem() const { return problem_; }
   bool estimated(BlockType type) const { return estimated_[static_cast<int>(type)]; }
 
-  // A keyframe at t with the NavState blocks from x, and the others from the newest keyframe (or their
-  // initial value in an empty window); not in the window yet.
+  // A keyframe at t with the NavState blocks from x, and the others from the newest keyframe (in an empty
+  // window: the values kept by KeepValues, or their initial value); not in the window yet.
   std::unique_ptr<Keyframe> Make(double t, const NavState& x) const;
+  // kf's blocks outside NavState (scale, time offset) as the start of the next empty window's first keyframe
+  // (a reset keeps what was learnt of the sensors); ForgetValues returns to the initial values.
+  void KeepValues(const Keyframe& kf);
+  void ForgetValues() { have_kept_ = false; }
   // Appends kf as the newest keyframe and adds its blocks to the problem in table order (those not
   // estimated held constant).
   Keyframe& Push(std::unique_ptr<Keyframe> kf);
@@ -222,8 +240,10 @@ class KeyframeStore {
   // nothing added to the problem. Takes ownership of cost; without a log it is deleted.
   void LogRejected(ceres::CostFunction* cost, ceres::LossFunction* loss, const std::vector<BlockRef>& blocks,
                    double gate);
-  // The covariance P0 (NavState tangent order) as a prior on kf's estimated blocks; a block outside
+  // The covariance P0 (NavState tangent order) in the estimated blocks' tangent order; a block outside
   // NavState gets its spec's prior_sigma, uncorrelated.
+  MatX PriorCovariance(const Mat15& P0) const;
+  // PriorCovariance(P0) as a prior on kf's estimated blocks.
   ceres::ResidualBlockId AddPrior(Keyframe& kf, const Mat15& P0);
   // The random-walk factors from prev to kf of the estimated blocks that have one, in table order.
   void AddRandomWalks(Keyframe& prev, Keyframe& kf);
@@ -236,6 +256,8 @@ class KeyframeStore {
   ceres::Problem* problem_ = nullptr;
   PoseManifold pose_manifold_;
   std::deque<std::unique_ptr<Keyframe>> window_;
+  bool have_kept_ = false;
+  double kept_[kKeyframeAmbientSize] = {};  // KeepValues's blocks (those outside NavState)
   uint64_t next_id_ = 0;
   FactorLog* log_ = nullptr;
   size_t last_logged_ = 0;

@@ -74,24 +74,13 @@ void Smoother::Initialize(const InitResult& init) {
   g_w_ = earth_.Gravity(init.x0.p_wb);
 
   std::unique_ptr<Keyframe> first = window_.Make(init.x0.t, init.x0);
-  first->block(BlockType::kScale)[0] = initial_scale_;
   // The initial covariance as a prior on the first keyframe.
   Keyframe& kf0 = window_.Push(std::move(first));
   prior_id_ = window_.AddPrior(kf0, init.P0);
   // Until the first solve, what the window knows of its keyframe is that prior.
   newest_cov_id_ = kf0.id;
   newest_two_cov_.resize(0, 0);
-  {
-    const std::vector<BlockType> types = window_.EstimatedTypes();
-    const std::vector<int> nav = NavIndexOfTangent(types);
-    newest_cov_ = MatX::Zero(nav.size(), nav.size());
-    for (size_t r = 0; r < nav.size(); ++r) {
-      for (size_t c = 0; c < nav.size(); ++c) {
-        if (nav[r] >= 0 && nav[c] >= 0) newest_cov_(r, c) = init.P0(nav[r], nav[c]);
-      }
-      if (nav[r] < 0) newest_cov_(r, r) = options_.wheel.scale_sigma * options_.wheel.scale_sigma;
-    }
-  }
+  newest_cov_ = window_.PriorCovariance(init.P0);
   solve_pending_ = false;
 
   preint_ = std::make_shared<Preintegration>(init.x0.bg, init.x0.ba, options_.imu.gyro_noise_density,
@@ -403,10 +392,10 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
       have_cov = OldestCovariance(window_, &cov);
     }
     init.x0 = at_fix.AllFinite() ? at_fix : window_.front().State();
-    initial_scale_ = window_.front().block(BlockType::kScale)[0];
+    window_.KeepValues(window_.front());
   } else {
     init.x0.q_wb = FallbackAttitude(m, options_);
-    initial_scale_ = 1.0;
+    window_.ForgetValues();
   }
   if (!have_cov) cov = FallbackCovariance(options_);
   init.g_norm = earth_.g_norm();
@@ -548,6 +537,12 @@ void Smoother::OutputFinal(const Keyframe& kf, const Keyframe* next, const Mat15
 void Smoother::Finish() {
   if (!initialized_) return;
   SolveIfPending();
+  // The time offset as the last solve left it: the newest keyframe's, with the σ of the last one solved.
+  final_time_offset_ = window_.back().block(BlockType::kTimeOffset)[0];
+  if (window_.estimated(BlockType::kTimeOffset) && newest_cov_.size() > 0) {
+    const MatX var = SubCovariance(window_.EstimatedTypes(), newest_cov_, {BlockType::kTimeOffset});
+    final_time_offset_sigma_ = std::sqrt(std::max(var(0, 0), 0.0));
+  }
   // Everything still in the window leaves it now, oldest first.
   while (window_.size() > 1) MarginalizeOldest(nullptr);
   Mat15 cov = Mat15::Zero();
@@ -561,6 +556,7 @@ void Smoother::Finish() {
     batch.Solve(factor_log_.get(), earth_);
     batch.Emit(*factor_log_, earth_, pre_init_.TwoSided(on_batch_));
     batch_stats_ = batch.stats().ToJson();
+    batch_stats_["time_offset"] = batch.TimeOffset();
   }
 }
 
@@ -581,6 +577,7 @@ nlohmann::json Smoother::Stats() const {
   j["prior_reliefs"] = prior_reliefs_;
   for (const auto& attacher : attachers_) attacher->AddStats(&j);
   j["final_odom_scale"] = last_scale_;
+  j["time_offset"] = TimeOffsetJson(options_.gnss, final_time_offset_, final_time_offset_sigma_);
   imu_gaps_.ToJson(&j);
   j["watchdog"] = watchdog_.ToJson();
   if (on_batch_) j["batch"] = batch_stats_;

@@ -118,7 +118,6 @@ class Smoother : public Estimator {
   double last_sample_t_ = 0.0;  // the newest sample's time; the initialisation's epoch before the first one
   double t_now_ = 0.0;
   NavState pred_;  // IMU-propagated from the newest keyframe, for initial values
-  double initial_scale_ = 1.0;  // odometer scale of the first keyframe (kept across a watchdog reset)
 
   // The measurements' attachers.
   std::vector<std::unique_ptr<MeasurementAttacher>> attachers_;
@@ -141,6 +140,7 @@ class Smoother : public Estimator {
   uint64_t solves_ = 0, iterations_ = 0, marginalizations_ = 0, keyframes_ = 0, reintegrations_ = 0;
   uint64_t solver_failures_ = 0, prior_reliefs_ = 0, covariance_failures_ = 0;
   double last_scale_ = 1.0;  // of the last keyframe to leave the window
+  double final_time_offset_ = 0.0, final_time_offset_sigma_ = 0.0;  // at Finish (td beyond the stated offset)
   double solve_time_ = 0.0, max_solve_time_ = 0.0, marg_time_ = 0.0;
 };
 

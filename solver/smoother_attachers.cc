@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/chi2.h"
+#include "factors/delayed_factor.h"
 #include "factors/gnss_factor.h"
 #include "factors/gvel_factor.h"
 #include "factors/heading_factor.h"
@@ -23,16 +24,77 @@ namespace {
 constexpr double kStandstillPositionSigma = 1e-4;  // m
 constexpr double kStandstillReach = 0.15;          // s
 
-// A state's blocks as values, to evaluate a factor at a predicted state before any keyframe holds it.
+// A state's blocks as values, to evaluate a factor at a predicted state before any keyframe holds it; the
+// time offset is the newest keyframe's.
 struct StateBlocks {
   std::array<double, pose::kAmbient> pose;
   Vec3 vel;
   Vec6 bias;
-  explicit StateBlocks(const NavState& x) : vel(x.v_w) {
+  double td;
+  StateBlocks(const NavState& x, const KeyframeStore& keyframes)
+      : vel(x.v_w), td(keyframes.back().block(BlockType::kTimeOffset)[0]) {
     SetPose(x.p_wb, x.q_wb, pose.data());
     bias << x.bg, x.ba;
   }
 };
+
+bool TimeOffsetEstimated(const AttachContext& ctx) { return ctx.keyframes.estimated(BlockType::kTimeOffset); }
+
+// A GNSS record's factor at t − td (the time offset estimated): the model M at the state the anchor predicts
+// for the stamp, taken back by the anchor keyframe's offset block (factors/delayed_factor.h).
+template <class M>
+ceres::CostFunction* DelayedFactor(const M& model, const Anchor& a, const Prediction& pred, const AttachContext& ctx,
+                                   std::vector<BlockRef>* blocks) {
+  const Delayed<M> delayed{model, ctx.Acceleration(pred.x), ctx.BodyRate(pred.x)};
+  if (a.partial == nullptr) {
+    *blocks = {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kTimeOffset}};
+    return DelayedAtKeyframeFactor<M>::Create(delayed);
+  }
+  *blocks = {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias},
+             {a.kf, BlockType::kTimeOffset}};
+  return DelayedAttachedCostFunction<M>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb), delayed);
+}
+
+// A measurement's check against the prediction (smoother_gate.h): its factor at the predicted blocks, with
+// their covariance; with the offset estimated, the delayed factor on pose, velocity and offset, so the
+// offset's σ widens the gate as the ESKF's H·P·Hᵀ does.
+struct GateCheck {
+  std::unique_ptr<ceres::CostFunction> cost;
+  std::vector<const double*> params;
+  std::vector<BlockKind> kinds;
+  MatX sigma;
+  FactorCheck Run(double inflation = 1.0) const {
+    return CheckFactor(*cost, params, kinds, inflation == 1.0 ? sigma : MatX(inflation * sigma));
+  }
+};
+
+// The check at the stamp (the offset held): cost on the predicted pose, and velocity if it takes one.
+GateCheck StampCheck(ceres::CostFunction* cost, const StateBlocks& at, bool with_velocity, const Prediction& pred,
+                     const AttachContext& ctx) {
+  GateCheck g;
+  g.cost.reset(cost);
+  g.params = {at.pose.data()};
+  g.kinds = {BlockKind::kPose};
+  std::vector<BlockType> blocks = {BlockType::kPose};
+  if (with_velocity) {
+    g.params.push_back(at.vel.data());
+    g.kinds.push_back(BlockKind::kEuclidean);
+    blocks.push_back(BlockType::kVelocity);
+  }
+  g.sigma = SubCovariance(ctx.keyframes.EstimatedTypes(), pred.cov, blocks);
+  return g;
+}
+
+template <class M>
+GateCheck DelayedCheck(const M& model, const Prediction& pred, const StateBlocks& at, const AttachContext& ctx) {
+  GateCheck g;
+  g.cost.reset(DelayedAtKeyframeFactor<M>::Create(Delayed<M>{model, ctx.Acceleration(pred.x), ctx.BodyRate(pred.x)}));
+  g.params = {at.pose.data(), at.vel.data(), &at.td};
+  g.kinds = {BlockKind::kPose, BlockKind::kEuclidean, BlockKind::kEuclidean};
+  g.sigma = SubCovariance(ctx.keyframes.EstimatedTypes(), pred.cov,
+                          {BlockType::kPose, BlockType::kVelocity, BlockType::kTimeOffset});
+  return g;
+}
 
 // The whitened innovation and its covariance back in the measurement's units, for GateInflation.
 void Unwhiten(const FactorCheck& c, const Vec3& sigma, Vec3* innovation, Mat3* S) {
@@ -51,6 +113,11 @@ ImuEarthTerms AttachContext::EarthTermsAt(const Vec3& p_w) const {
 
 Vec3 AttachContext::BodyRate(const NavState& x) const {
   return last_imu ? Vec3(last_imu->gyro - x.bg - x.q_wb.conjugate() * earth.rate_w()) : Vec3::Zero();
+}
+
+Vec3 AttachContext::Acceleration(const NavState& x) const {
+  if (!last_imu) return Vec3::Zero();
+  return x.q_wb * (last_imu->acc - x.ba) + earth.Gravity(x.p_wb) - 2.0 * earth.rate_w().cross(x.v_w);
 }
 
 // --- GNSS -------------------------------------------------------------------------------------------------
@@ -76,6 +143,9 @@ bool GnssAttacher::OnGnss(const GnssMeasurement& m, const AttachContext& ctx) {
 
 ceres::CostFunction* GnssAttacher::PositionFactor(const GnssMeasurement& m, const Prediction& pred, const Anchor& a,
                                                   const AttachContext& ctx, std::vector<BlockRef>* blocks) const {
+  if (TimeOffsetEstimated(ctx)) {
+    return DelayedFactor(GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), options_.gnss.lever_b}, a, pred, ctx, blocks);
+  }
   if (a.partial == nullptr) {
     *blocks = {{a.kf, BlockType::kPose}};
     return GnssFactor::Create(m.p_w, m.sigma_w, options_.gnss.lever_b);
@@ -86,14 +156,14 @@ ceres::CostFunction* GnssAttacher::PositionFactor(const GnssMeasurement& m, cons
 }
 
 bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx) {
-  const std::vector<BlockType> types = ctx.keyframes.EstimatedTypes();
-  const StateBlocks at(pred.x);
-  const std::unique_ptr<ceres::CostFunction> check_cost(GnssFactor::Create(m.p_w, m.sigma_w, options_.gnss.lever_b));
-  MatX sigma = SubCovariance(types, pred.cov, {BlockType::kPose});
+  const StateBlocks at(pred.x, ctx.keyframes);
+  const GateCheck gate =
+      TimeOffsetEstimated(ctx)
+          ? DelayedCheck(GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), options_.gnss.lever_b}, pred, at, ctx)
+          : StampCheck(GnssFactor::Create(m.p_w, m.sigma_w, options_.gnss.lever_b), at, false, pred, ctx);
   const double inflation = inflation_.factor();
-  const FactorCheck plain = CheckFactor(*check_cost, {at.pose.data()}, {BlockKind::kPose}, sigma);
-  const FactorCheck check =
-      inflation > 1.0 ? CheckFactor(*check_cost, {at.pose.data()}, {BlockKind::kPose}, inflation * sigma) : plain;
+  const FactorCheck plain = gate.Run();
+  const FactorCheck check = inflation > 1.0 ? gate.Run(inflation) : plain;
   if (!check.Passes(gate_position_)) {
     position_counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
     if (ctx.keyframes.log() != nullptr && check.evaluated) {
@@ -128,20 +198,21 @@ bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pr
 }
 
 bool GnssAttacher::AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx) {
-  const std::vector<BlockType> types = ctx.keyframes.EstimatedTypes();
-  const StateBlocks at(pred.x);
-  const std::unique_ptr<ceres::CostFunction> check_cost(
-      HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw));
-  const FactorCheck check = CheckFactor(*check_cost, {at.pose.data()}, {BlockKind::kPose},
-                                        SubCovariance(types, pred.cov, {BlockType::kPose}));
+  const StateBlocks at(pred.x, ctx.keyframes);
+  const HeadingAtTime model{m.yaw_G, 1.0 / m.sigma_yaw, options_.gnss.mount_yaw};
+  const GateCheck gate =
+      TimeOffsetEstimated(ctx)
+          ? DelayedCheck(model, pred, at, ctx)
+          : StampCheck(HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw), at, false, pred, ctx);
+  const FactorCheck check = gate.Run();
   const auto factor = [&](const Anchor& a, std::vector<BlockRef>* blocks) -> ceres::CostFunction* {
+    if (TimeOffsetEstimated(ctx)) return DelayedFactor(model, a, pred, ctx, blocks);
     if (a.partial == nullptr) {
       *blocks = {{a.kf, BlockType::kPose}};
       return HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw);
     }
     *blocks = {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}};
-    return PreintAttachedFactor<HeadingAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb),
-                                                       HeadingAtTime{m.yaw_G, 1.0 / m.sigma_yaw, options_.gnss.mount_yaw});
+    return PreintAttachedFactor<HeadingAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb), model);
   };
   std::vector<BlockRef> blocks;
   if (!check.Passes(gate_heading_)) {
@@ -173,27 +244,29 @@ GvelAttacher::GvelAttacher(const EstimatorOptions& options)
 
 bool GvelAttacher::OnGvel(const GvelMeasurement& m, const AttachContext& ctx) {
   const Prediction pred = ctx.predict(m.t);
-  const std::vector<BlockType> types = ctx.keyframes.EstimatedTypes();
-  const StateBlocks at(pred.x);
+  const StateBlocks at(pred.x, ctx.keyframes);
   const Vec3 omega_b = ctx.BodyRate(pred.x);
-  const std::unique_ptr<ceres::CostFunction> check_cost(
-      GvelFactor::Create(m.v_w, m.sigma_w, omega_b, options_.gnss.lever_b));
-  const FactorCheck check = CheckFactor(*check_cost, {at.pose.data(), at.vel.data()},
-                                        {BlockKind::kPose, BlockKind::kEuclidean},
-                                        SubCovariance(types, pred.cov, {BlockType::kPose, BlockType::kVelocity}));
+  const GvelAtTime model{m.v_w, m.sigma_w.cwiseInverse(), omega_b, options_.gnss.lever_b};
+  const GateCheck gate =
+      TimeOffsetEstimated(ctx)
+          ? DelayedCheck(model, pred, at, ctx)
+          : StampCheck(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, options_.gnss.lever_b), at, true, pred, ctx);
+  const FactorCheck check = gate.Run();
   if (!check.Passes(gate_)) {
     counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
     return false;
   }
   const Anchor a = ctx.anchor(m.t);
-  if (a.partial == nullptr) {
+  if (TimeOffsetEstimated(ctx)) {
+    std::vector<BlockRef> blocks;
+    ceres::CostFunction* cost = DelayedFactor(model, a, pred, ctx, &blocks);
+    ctx.keyframes.AddFactor(cost, loss_.get(), blocks);
+  } else if (a.partial == nullptr) {
     ctx.keyframes.AddFactor(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, options_.gnss.lever_b), loss_.get(),
                             {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}});
   } else {
     ctx.keyframes.AddFactor(
-        PreintAttachedFactor<GvelAtTime>::Create(
-            a.partial, ctx.EarthTermsAt(pred.x.p_wb),
-            GvelAtTime{m.v_w, m.sigma_w.cwiseInverse(), omega_b, options_.gnss.lever_b}),
+        PreintAttachedFactor<GvelAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb), model),
         loss_.get(), {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}});
   }
   ++counts_.used;

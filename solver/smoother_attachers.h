@@ -83,6 +83,8 @@ struct AttachContext {
   ImuEarthTerms EarthTermsAt(const Vec3& p_w) const;
   // The body's rate against w from the last IMU sample, with the biases of x.
   Vec3 BodyRate(const NavState& x) const;
+  // The acceleration in w from the last IMU sample, with the state x (gravity and Coriolis included).
+  Vec3 Acceleration(const NavState& x) const;
 };
 
 class MeasurementAttacher {

@@ -2,22 +2,31 @@
 
 #include <Eigen/Cholesky>
 
+#include <utility>
+
 namespace gins {
 namespace {
 
-// Block-order tangent index of each NavState coordinate, and of the scale (−1 when not estimated).
+// Block-order tangent index of each NavState coordinate (−1 outside NavState), and the process noise per
+// second of the coordinates outside it (their blocks' random walks).
 struct Layout {
-  std::vector<int> nav_of;  // per block-order coordinate: its NavState index, or −1 (scale)
-  int scale = -1;
+  std::vector<int> nav_of;
+  std::vector<std::pair<int, double>> walks;  // (block-order index, σ² per s)
   int n = 0;
 };
 
-Layout LayoutOf(const std::vector<BlockType>& types) {
+Layout LayoutOf(const std::vector<BlockType>& types, const EstimatorOptions& options) {
   Layout l;
   l.nav_of = NavIndexOfTangent(types);
   l.n = static_cast<int>(l.nav_of.size());
-  for (int k = 0; k < l.n; ++k) {
-    if (l.nav_of[k] < 0) l.scale = k;
+  int offset = 0;
+  for (BlockType type : types) {
+    const BlockSpec& spec = SpecOf(type);
+    if (spec.num_runs == 0) {
+      const double sigma = spec.random_walk_sigma != nullptr ? spec.random_walk_sigma(options) : 0.0;
+      for (int k = 0; k < spec.tangent_size; ++k) l.walks.emplace_back(offset + k, sigma * sigma);
+    }
+    offset += spec.tangent_size;
   }
   return l;
 }
@@ -26,8 +35,8 @@ Layout LayoutOf(const std::vector<BlockType>& types) {
 
 MatX PredictBlockCovariance(const std::vector<BlockType>& types, const MatX& cov_i, const NavState& x_i,
                             const Preintegration& pre, const EstimatorOptions& options, MatX* joint) {
-  const Layout l = LayoutOf(types);
-  // Φ and Q in block order: NavState's through the preintegration, the scale a random walk.
+  const Layout l = LayoutOf(types, options);
+  // Φ and Q in block order: NavState's through the preintegration, the other blocks random walks.
   Mat15 Phi15, Q15;
   PredictedTransition(x_i, pre, options.imu.gyro_bias_rw, options.imu.acc_bias_rw, &Phi15, &Q15);
   MatX Phi = MatX::Zero(l.n, l.n), Q = MatX::Zero(l.n, l.n);
@@ -39,9 +48,9 @@ MatX PredictBlockCovariance(const std::vector<BlockType>& types, const MatX& cov
       }
     }
   }
-  if (l.scale >= 0) {
-    Phi(l.scale, l.scale) = 1.0;
-    Q(l.scale, l.scale) = options.wheel.scale_rw * options.wheel.scale_rw * pre.dt();
+  for (const auto& [k, q] : l.walks) {
+    Phi(k, k) = 1.0;
+    Q(k, k) = q * pre.dt();
   }
   const MatX cross = Phi * cov_i;  // cov(j, i)
   MatX cov_j = cross * Phi.transpose() + Q;

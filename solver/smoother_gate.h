@@ -18,7 +18,7 @@
 namespace gins {
 
 // The covariance of the state at the end of `pre` (from keyframe state x_i with block-order covariance
-// cov_i): the preintegrated transition, the IMU noise over it and the random walks of biases and scale.
+// cov_i): the preintegrated transition, the IMU noise over it and the random walks of biases, scale and time offset.
 // joint (optional): the covariance of both, i's blocks then the predicted ones.
 MatX PredictBlockCovariance(const std::vector<BlockType>& types, const MatX& cov_i, const NavState& x_i,
                             const Preintegration& pre, const EstimatorOptions& options, MatX* joint = nullptr);

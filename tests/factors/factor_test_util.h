@@ -7,11 +7,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "core/conventions.h"
+#include "core/imu_kernel.h"
+#include "core/preintegration.h"
 #include "core/so3.h"
 #include "factors/pose_manifold.h"
 #include "test_util.h"
@@ -123,6 +126,52 @@ inline double CheckJacobians(const ceres::CostFunction& cost,
   }
   EXPECT_LT(worst, relative_precision) << what << "\n" << results.error_log;
   return worst;
+}
+
+// 0.7 s of a turning, accelerating body preintegrated from keyframe i, its biases off zero: the interval
+// of the attached factors' Jacobian tests.
+struct AttachedInterval {
+  std::shared_ptr<Preintegration> preint;
+  ImuEarthTerms earth;
+  PoseBlock pose_i;
+  Vec3 vel_i;
+  Vec6 bias;
+};
+
+inline AttachedInterval MakeAttachedInterval(const Vec3& rate_w) {
+  AttachedInterval s;
+  s.earth.g_w = GravityWorld(9.81);
+  s.earth.rate_w = rate_w;
+  s.bias << 0.01, -0.02, 0.005, 0.1, 0.05, -0.08;
+  s.pose_i = MakePose(Vec3(12.0, 4.0, -0.2), ExpQuat<double>(Vec3(0.1, -0.3, 2.0)));
+  s.vel_i = Vec3(10.0, -4.0, 2.0);
+  s.preint = std::make_shared<Preintegration>(s.bias.head<3>(), s.bias.tail<3>(), 2e-3, 2e-2);
+  for (int k = 0; k < 70; ++k) {
+    const double t = k * 0.01;
+    const Vec3 omega(0.3 * std::sin(2.0 * t), -0.2, 0.5 * std::sin(0.7 * t + 1.0));
+    const Vec3 acc(1.0 + 0.5 * std::cos(1.3 * t), 0.4, 9.81 + 0.3 * std::sin(t));
+    s.preint->Integrate(omega + s.bias.head<3>(), acc + s.bias.tail<3>(), 0.01);
+  }
+  return s;
+}
+
+// Keyframe i's blocks away from where the interval starts (and its biases away from their linearisation
+// point, so the first-order bias correction matters).
+struct AttachedBlocks {
+  PoseBlock pose;
+  Vec3 vel;
+  Vec6 bias;
+};
+
+inline AttachedBlocks PerturbedBlocks(std::mt19937& rng, const PoseBlock& pose_i, const Vec3& vel_i,
+                                      const Vec6& bias) {
+  AttachedBlocks b;
+  b.pose = RandomPoseNear(rng, pose_i, 1.0, 0.3);
+  b.vel = vel_i + RandomVec3(rng, 1.0);
+  b.bias = bias;
+  b.bias.head<3>() += RandomVec3(rng, 0.02);
+  b.bias.tail<3>() += RandomVec3(rng, 0.2);
+  return b;
 }
 
 }  // namespace gins::test

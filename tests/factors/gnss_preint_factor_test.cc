@@ -65,11 +65,7 @@ TEST(GnssPreintFactorTest, JacobiansMatchNumeric) {
   const PoseManifold m;
   std::mt19937 rng(9);
   for (int trial = 0; trial < 6; ++trial) {
-    const test::PoseBlock pose = test::RandomPoseNear(rng, s.pose_i, 1.0, 0.3);
-    const Vec3 v = s.vel_i + test::RandomVec3(rng, 1.0);
-    Vec6 b = s.bias;
-    b.head<3>() += test::RandomVec3(rng, 0.02);
-    b.tail<3>() += test::RandomVec3(rng, 0.2);
+    const auto [pose, v, b] = test::PerturbedBlocks(rng, s.pose_i, s.vel_i, s.bias);
     test::CheckJacobians(*cost, {&m, nullptr, nullptr}, {pose.data(), v.data(), b.data()}, 1e-6,
                          "gnss preint " + std::to_string(trial));
   }

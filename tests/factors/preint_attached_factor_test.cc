@@ -11,42 +11,16 @@
 #include <string>
 #include <vector>
 
-#include "core/imu_kernel.h"
 #include "factor_test_util.h"
 
 namespace gins {
 namespace {
 
-struct Interval {
-  std::shared_ptr<Preintegration> preint;
-  ImuEarthTerms earth;
-  test::PoseBlock pose_i;
-  Vec3 vel_i;
-  Vec6 bias;
-};
-
-Interval MakeInterval(const Vec3& rate_w) {
-  Interval s;
-  s.earth.g_w = GravityWorld(9.81);
-  s.earth.rate_w = rate_w;
-  s.bias << 0.01, -0.02, 0.005, 0.1, 0.05, -0.08;
-  s.pose_i = test::MakePose(Vec3(12.0, 4.0, -0.2), ExpQuat<double>(Vec3(0.1, -0.3, 2.0)));
-  s.vel_i = Vec3(10.0, -4.0, 2.0);
-  s.preint = std::make_shared<Preintegration>(s.bias.head<3>(), s.bias.tail<3>(), 2e-3, 2e-2);
-  for (int k = 0; k < 70; ++k) {  // 0.7 s of a turning, accelerating body
-    const double t = k * 0.01;
-    const Vec3 omega(0.3 * std::sin(2.0 * t), -0.2, 0.5 * std::sin(0.7 * t + 1.0));
-    const Vec3 acc(1.0 + 0.5 * std::cos(1.3 * t), 0.4, 9.81 + 0.3 * std::sin(t));
-    s.preint->Integrate(omega + s.bias.head<3>(), acc + s.bias.tail<3>(), 0.01);
-  }
-  return s;
-}
-
 template <class Measurement>
 void ExpectAnalyticMatches(const Measurement& measurement, const std::string& what) {
   // Zero and an exaggerated Earth rate (its terms must show above the tolerance).
   for (const Vec3& rate : {Vec3(Vec3::Zero()), Vec3(0.01, 0.03, 0.04)}) {
-    const Interval s = MakeInterval(rate);
+    const test::AttachedInterval s = test::MakeAttachedInterval(rate);
     const std::unique_ptr<ceres::CostFunction> analytic(
         PreintAttachedFactor<Measurement>::Create(s.preint, s.earth, measurement));
     const std::unique_ptr<ceres::CostFunction> autodiff(
@@ -55,11 +29,7 @@ void ExpectAnalyticMatches(const Measurement& measurement, const std::string& wh
     const PoseManifold manifold;
     std::mt19937 rng(17);
     for (int trial = 0; trial < 8; ++trial) {
-      const test::PoseBlock pose = test::RandomPoseNear(rng, s.pose_i, 1.0, 0.3);
-      const Vec3 v = s.vel_i + test::RandomVec3(rng, 1.0);
-      Vec6 b = s.bias;
-      b.head<3>() += test::RandomVec3(rng, 0.02);
-      b.tail<3>() += test::RandomVec3(rng, 0.2);
+      const auto [pose, v, b] = test::PerturbedBlocks(rng, s.pose_i, s.vel_i, s.bias);
       const double* params[] = {pose.data(), v.data(), b.data()};
       Eigen::Matrix<double, M, 1> r_a, r_d;
       Eigen::Matrix<double, M, 7, Eigen::RowMajor> Jp_a, Jp_d;

@@ -35,15 +35,16 @@ TEST(KeyframeBlocks, TangentRunsReproduceNavStateOrder) {
   // Pose (δp, δθ), velocity (δv), bias (δbg, δba) -> NavState δp, δv, δθ, δbg, δba.
   const std::vector<int> expected = {0, 1, 2, 6, 7, 8, 3, 4, 5, 9, 10, 11, 12, 13, 14};
   EXPECT_EQ(NavIndexOfTangent(kNavBlocks), expected);
-  // The scale is outside NavState; every NavState coordinate is some block's, once.
-  std::vector<int> all =
-      NavIndexOfTangent({BlockType::kPose, BlockType::kVelocity, BlockType::kBias, BlockType::kScale});
-  ASSERT_EQ(all.size(), 16u);
-  EXPECT_EQ(all.back(), -1);
-  all.pop_back();
+  // The scale and the time offset are outside NavState; every NavState coordinate is some block's, once.
+  std::vector<int> all = NavIndexOfTangent(
+      {BlockType::kPose, BlockType::kVelocity, BlockType::kBias, BlockType::kScale, BlockType::kTimeOffset});
+  ASSERT_EQ(all.size(), 17u);
+  EXPECT_EQ(all[15], -1);
+  EXPECT_EQ(all[16], -1);
+  all.resize(15);
   std::sort(all.begin(), all.end());
   for (int i = 0; i < nav::kDim; ++i) EXPECT_EQ(all[i], i);
-  EXPECT_EQ(kKeyframeAmbientSize, 17);
+  EXPECT_EQ(kKeyframeAmbientSize, 18);
 }
 
 TEST(KeyframeBlocks, BlockPerturbationsAreNavStateBoxplus) {
@@ -121,6 +122,43 @@ TEST(KeyframeStore, ScaleEstimatedOnlyWithWheelsAndEstimateScale) {
       EXPECT_EQ(store.EstimatedBlocks(kf).size(), scale ? 4u : 3u);
     }
   }
+}
+
+TEST(KeyframeStore, TimeOffsetEstimatedOnlyWhenAskedForAndListedLast) {
+  for (bool estimate : {false, true}) {
+    EstimatorOptions options = test::WindowOptions(true);
+    options.gnss.estimate_time_offset = estimate;
+    const KeyframeStore store(options);
+    EXPECT_EQ(store.estimated(BlockType::kTimeOffset), estimate);
+    const std::vector<BlockType> types = store.EstimatedTypes();
+    EXPECT_EQ(types.back(), estimate ? BlockType::kTimeOffset : BlockType::kScale);
+    // Outside NavState: its tangent has no NavState index.
+    EXPECT_EQ(NavIndexOfTangent({BlockType::kTimeOffset}), std::vector<int>{-1});
+  }
+}
+
+TEST(KeyframeStore, KeptValuesStartTheNextWindow) {
+  // A watchdog reset keeps what the window learnt of the sensors (scale, time offset) for its first keyframe.
+  EstimatorOptions options = test::WindowOptions(true);
+  options.gnss.estimate_time_offset = true;
+  KeyframeStore store(options);
+  ceres::Problem problem(test::SmootherProblemOptions());
+  store.Reset(&problem);
+  std::mt19937 rng(3);
+  Keyframe& kf = store.Push(store.Make(1.0, RandomState(rng)));
+  EXPECT_EQ(kf.block(BlockType::kTimeOffset)[0], 0.0);  // the spec's initial value
+  kf.block(BlockType::kScale)[0] = 1.03;
+  kf.block(BlockType::kTimeOffset)[0] = 0.093;
+  store.KeepValues(kf);
+  ceres::Problem fresh(test::SmootherProblemOptions());
+  store.Reset(&fresh);
+  const std::unique_ptr<Keyframe> next = store.Make(2.0, RandomState(rng));
+  EXPECT_EQ(next->block(BlockType::kScale)[0], 1.03);
+  EXPECT_EQ(next->block(BlockType::kTimeOffset)[0], 0.093);
+  store.ForgetValues();
+  const std::unique_ptr<Keyframe> forgotten = store.Make(3.0, RandomState(rng));
+  EXPECT_EQ(forgotten->block(BlockType::kScale)[0], 1.0);
+  EXPECT_EQ(forgotten->block(BlockType::kTimeOffset)[0], 0.0);
 }
 
 TEST(KeyframeStore, MakeCarriesBlocksOutsideNavStateAndListsInTimeThenTableOrder) {

@@ -2,7 +2,7 @@
 // time-offset block: the measurement's model at the state at t − td, taken back from the state at the stamp t
 // through the acceleration a_w and body rate ω_b there (core/time_shift.h: second order in td).
 //
-//   DelayedAtKeyframeFactor<M>     the stamp at keyframe i's time.
+//   DelayedAtKeyframeFactor<M>     the stamp at keyframe i's time (DelayedAtKeyframeCostFunction).
 //                                  Blocks: pose_i (7), vel_i (3), td_i (1).
 //   DelayedAttachedCostFunction<M> the stamp between keyframe i and the next: the state at t from the IMU
 //                                  preintegrated from t_i (PreintAttachedCostFunction's prediction and
@@ -50,11 +50,27 @@ class DelayedAtKeyframeFactor {
     return true;
   }
 
-  // AutoDiffCostFunction<DelayedAtKeyframeFactor, kResidualDim, 7, 3, 1>.
+  // The production cost function: DelayedAtKeyframeCostFunction (the model's Jacobian in the tangent from
+  // Jets, lifted to the ambient pose).
   static ceres::CostFunction* Create(Delayed<Measurement> delayed);
+  // AutoDiffCostFunction<DelayedAtKeyframeFactor, kResidualDim, 7, 3, 1> of the same residual: the test oracle.
+  static ceres::CostFunction* CreateAutoDiff(Delayed<Measurement> delayed);
+
+  const Delayed<Measurement>& delayed() const { return delayed_; }
 
  private:
   Delayed<Measurement> delayed_;
+};
+
+template <class Measurement>
+class DelayedAtKeyframeCostFunction final
+    : public ceres::SizedCostFunction<Measurement::kResidualDim, pose::kAmbient, 3, 1> {
+ public:
+  explicit DelayedAtKeyframeCostFunction(Delayed<Measurement> delayed) : factor_(std::move(delayed)) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+ private:
+  DelayedAtKeyframeFactor<Measurement> factor_;
 };
 
 template <class Measurement>

@@ -72,6 +72,11 @@ template class PreintAttachedFactor<GvelAtTime>;
 
 template <class Measurement>
 ceres::CostFunction* DelayedAtKeyframeFactor<Measurement>::Create(Delayed<Measurement> delayed) {
+  return new DelayedAtKeyframeCostFunction<Measurement>(std::move(delayed));
+}
+
+template <class Measurement>
+ceres::CostFunction* DelayedAtKeyframeFactor<Measurement>::CreateAutoDiff(Delayed<Measurement> delayed) {
   return new ceres::AutoDiffCostFunction<DelayedAtKeyframeFactor<Measurement>, Measurement::kResidualDim,
                                          pose::kAmbient, 3, 1>(new DelayedAtKeyframeFactor<Measurement>(delayed));
 }

@@ -43,21 +43,13 @@ Mat9x15 PredictionJacobian(const Preintegration& pre, const ImuEarthTerms& earth
   return J;
 }
 
-// The measurement at the state predicted at its stamp t (kDelayed: at t − td, td the fourth block), its
-// Jacobians the prediction's times the measurement's own in (δp_t, δθ_t, δv_t[, td]) from Jets.
-template <class Measurement, bool kDelayed>
-bool EvaluateAttached(const PreintAttachedFactor<Measurement>& factor, const Vec3& a_w, const Vec3& omega_b,
-                      double const* const* parameters, double* residuals, double** jacobians) {
+// The measurement at kinematics k, its residual and its Jacobian in the right-perturbed (δp, δθ, δv) from Jets.
+template <class Measurement>
+Eigen::Matrix<double, Measurement::kResidualDim, 9> MeasureAt(const Measurement& measurement,
+                                                              const PredictedKinematics<double>& k,
+                                                              double* residuals) {
   constexpr int M = Measurement::kResidualDim;
-  constexpr int kJet = kDelayed ? 10 : 9;
-  const double* pose_i = parameters[0];
-  const Eigen::Map<const Vec3> p_i(pose_i + pose::kP), v_i(parameters[1]);
-  const Eigen::Map<const Quat> q_i(pose_i + pose::kQ);
-  const Eigen::Map<const Vec3> bg(parameters[2]), ba(parameters[2] + 3);
-  const Preintegration& pre = factor.preintegration();
-  const PredictedKinematics<double> k = PredictKinematics<double>(
-      pre, factor.earth(), factor.turns(), Vec3(p_i), Quat(q_i), Vec3(v_i), Vec3(bg), Vec3(ba));
-  using Jet = ceres::Jet<double, kJet>;
+  using Jet = ceres::Jet<double, 9>;
   PredictedKinematics<Jet> kj;
   Eigen::Matrix<Jet, 3, 1> dtheta;
   for (int c = 0; c < 3; ++c) {
@@ -67,15 +59,54 @@ bool EvaluateAttached(const PreintAttachedFactor<Measurement>& factor, const Vec
   }
   kj.q = k.q.cast<Jet>() * ExpQuat<Jet>(dtheta);
   Jet r[M];
-  if constexpr (kDelayed) {
-    Delayed<Measurement>{factor.measurement(), a_w, omega_b}(kj, Jet(parameters[3][0], 9), r);
-  } else {
-    factor.measurement()(kj, r);
-  }
-  Eigen::Matrix<double, M, kJet> J_meas;
+  measurement(kj, r);
+  Eigen::Matrix<double, M, 9> J_meas;
   for (int i = 0; i < M; ++i) {
     residuals[i] = r[i].a;
     J_meas.row(i) = r[i].v.transpose();
+  }
+  return J_meas;
+}
+
+// The same at k's time − td (Delayed, core/time_shift.h), in (δp, δθ, δv, td): the model's Jacobian at the
+// shifted state times the shift's, in closed form: δp_s = δp − td·δv, δv_s = δv, δθ_s = Exp(ω·td)·δθ, and in
+// td: −v + a·td, −a, −ω (the rotation's right Jacobian leaves its own axis as it is).
+template <class Measurement>
+Eigen::Matrix<double, Measurement::kResidualDim, 10> MeasureDelayedAt(const Delayed<Measurement>& d,
+                                                                      const PredictedKinematics<double>& k,
+                                                                      double td, double* residuals) {
+  const ShiftedKinematics<double> s = ShiftBack<double>(k.p, k.v, k.q, d.a_w, d.omega_b, td);
+  const auto J_s = MeasureAt(d.measurement, PredictedKinematics<double>{s.p_wb, s.v_w, s.q_wb}, residuals);
+  Eigen::Matrix<double, 9, 10> S = Eigen::Matrix<double, 9, 10>::Zero();
+  S.block<3, 3>(kRowP, kRowP).setIdentity();
+  S.block<3, 3>(kRowP, kRowV) = -td * Mat3::Identity();
+  S.block<3, 3>(kRowTheta, kRowTheta) = ExpMat(d.omega_b * td);
+  S.block<3, 3>(kRowV, kRowV).setIdentity();
+  S.block<3, 1>(kRowP, 9) = -k.v + d.a_w * td;
+  S.block<3, 1>(kRowTheta, 9) = -d.omega_b;
+  S.block<3, 1>(kRowV, 9) = -d.a_w;
+  return J_s * S;
+}
+
+// The measurement at the state predicted at its stamp t (kDelayed: at t − td, td the fourth block), its
+// Jacobians the prediction's times the measurement's own.
+template <class Measurement, bool kDelayed>
+bool EvaluateAttached(const PreintAttachedFactor<Measurement>& factor, const Vec3& a_w, const Vec3& omega_b,
+                      double const* const* parameters, double* residuals, double** jacobians) {
+  constexpr int M = Measurement::kResidualDim;
+  const double* pose_i = parameters[0];
+  const Eigen::Map<const Vec3> p_i(pose_i + pose::kP), v_i(parameters[1]);
+  const Eigen::Map<const Quat> q_i(pose_i + pose::kQ);
+  const Eigen::Map<const Vec3> bg(parameters[2]), ba(parameters[2] + 3);
+  const Preintegration& pre = factor.preintegration();
+  const PredictedKinematics<double> k = PredictKinematics<double>(
+      pre, factor.earth(), factor.turns(), Vec3(p_i), Quat(q_i), Vec3(v_i), Vec3(bg), Vec3(ba));
+  Eigen::Matrix<double, M, kDelayed ? 10 : 9> J_meas;
+  if constexpr (kDelayed) {
+    J_meas = MeasureDelayedAt(Delayed<Measurement>{factor.measurement(), a_w, omega_b}, k, parameters[3][0],
+                              residuals);
+  } else {
+    J_meas = MeasureAt(factor.measurement(), k, residuals);
   }
   if (jacobians == nullptr) return true;
   const Eigen::Matrix<double, M, 9> J_state = J_meas.template leftCols<9>();
@@ -115,6 +146,31 @@ template <class Measurement>
 bool DelayedAttachedCostFunction<Measurement>::Evaluate(double const* const* parameters, double* residuals,
                                                         double** jacobians) const {
   return EvaluateAttached<Measurement, true>(factor_, a_w_, omega_b_, parameters, residuals, jacobians);
+}
+
+template <class Measurement>
+bool DelayedAtKeyframeCostFunction<Measurement>::Evaluate(double const* const* parameters, double* residuals,
+                                                          double** jacobians) const {
+  constexpr int M = Measurement::kResidualDim;
+  const Eigen::Map<const Quat> q(parameters[0] + pose::kQ);
+  const PredictedKinematics<double> k{Eigen::Map<const Vec3>(parameters[0] + pose::kP),
+                                      Eigen::Map<const Vec3>(parameters[1]), Quat(q)};
+  const Delayed<Measurement>& d = factor_.delayed();
+  const Eigen::Matrix<double, M, 10> J = MeasureDelayedAt(d, k, parameters[2][0], residuals);
+  if (jacobians == nullptr) return true;
+  if (jacobians[0] != nullptr) {
+    WriteAmbientPoseJacobian<M>(J.template middleCols<3>(kRowP), J.template middleCols<3>(kRowTheta), Quat(q),
+                                jacobians[0]);
+  }
+  if (jacobians[1] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, M, 3, Eigen::RowMajor>> out(jacobians[1]);
+    out = J.template middleCols<3>(kRowV);
+  }
+  if (jacobians[2] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, M, 1>> out(jacobians[2]);
+    out = J.template rightCols<1>();
+  }
+  return true;
 }
 
 namespace {
@@ -160,5 +216,8 @@ template class PreintAttachedCostFunction<GvelAtTime>;
 template class DelayedAttachedCostFunction<GnssAtTime>;
 template class DelayedAttachedCostFunction<HeadingAtTime>;
 template class DelayedAttachedCostFunction<GvelAtTime>;
+template class DelayedAtKeyframeCostFunction<GnssAtTime>;
+template class DelayedAtKeyframeCostFunction<HeadingAtTime>;
+template class DelayedAtKeyframeCostFunction<GvelAtTime>;
 
 }  // namespace gins

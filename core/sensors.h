@@ -39,7 +39,7 @@ struct GnssOptions {
   // solver/keyframe.h) estimate the rest as a state, from 0 with 1-σ time_offset_sigma and a random walk
   // time_offset_rw.
   double time_offset = 0.0;
-  bool estimate_time_offset = false;
+  bool estimate_time_offset = true;
   double time_offset_sigma = 0.1;  // gnss.time_offset_sigma_s
   double time_offset_rw = 1e-4;    // gnss.time_offset_rw_s_sqrt_s → s/√s
   // gnss.error_correlation_s: correlation time τ of the fixes' errors; each σ is inflated by

@@ -60,6 +60,10 @@ inline Options TestRunOptions(const SimOptions& sim) {
   o.wheel.radius = sim.wheel_radius;
   o.wheel.pulses_per_rev = sim.pulses_per_rev;
   o.wheel.interval = 1.0 / sim.wheel_rate;
+  // The simulated GNSS is stamped at its measurement time: stated, as a config states a known latency (the
+  // default estimates it, at the cost of its σ along the track; cli_test's time-offset test covers that).
+  o.gnss.time_offset = 0.0;
+  o.gnss.estimate_time_offset = false;
   return o;
 }
 

@@ -101,6 +101,7 @@ TEST(KeyframeStore, ScaleEstimatedOnlyWithWheelsAndEstimateScale) {
       EstimatorOptions options;
       options.wheel.enabled = wheels;
       options.wheel.estimate_scale = estimate;
+      options.gnss.estimate_time_offset = false;  // TimeOffsetEstimatedOnlyWhenAskedForAndListedLast
       KeyframeStore store(options);
       const bool scale = wheels && estimate;
       EXPECT_EQ(store.estimated(BlockType::kScale), scale);
@@ -185,7 +186,9 @@ TEST(KeyframeStore, MakeCarriesBlocksOutsideNavStateAndListsInTimeThenTableOrder
 
 TEST(KeyframeStore, PriorReproducesTheCovariance) {
   for (bool estimate_scale : {false, true}) {
-    const EstimatorOptions options = test::WindowOptions(estimate_scale);
+    EstimatorOptions options = test::WindowOptions(estimate_scale);
+    options.gnss.estimate_time_offset = true;
+    options.gnss.time_offset_sigma = 0.05;
     KeyframeStore store(options);
     ceres::Problem problem(test::SmootherProblemOptions());
     store.Reset(&problem);
@@ -209,8 +212,9 @@ TEST(KeyframeStore, PriorReproducesTheCovariance) {
         double want = 0.0;
         if (nav[i] >= 0 && nav[j] >= 0) {
           want = P0(nav[i], nav[j]);
-        } else if (i == j) {
-          want = options.wheel.scale_sigma * options.wheel.scale_sigma;
+        } else if (i == j) {  // the scale's or the time offset's own σ
+          const double sigma = i == P.rows() - 1 ? options.gnss.time_offset_sigma : options.wheel.scale_sigma;
+          want = sigma * sigma;
         }
         EXPECT_NEAR(P(i, j), want, 1e-10) << i << "," << j;
       }

@@ -33,6 +33,7 @@ inline EstimatorOptions WindowOptions(bool estimate_scale) {
   EstimatorOptions options;
   options.wheel.enabled = true;
   options.wheel.estimate_scale = estimate_scale;
+  options.gnss.estimate_time_offset = false;  // the window's tests of it set it
   return options;
 }
 

@@ -116,6 +116,7 @@ nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nloh
     if (r.source == "input") refused[r.measurement][r.reason] = r.count;
   }
   input["reorder"] = {{"window_s", session_stats["session"]["reorder_window_s"]}, {"sorted", status.reordered}};
+  input["stamps"] = session_stats["session"]["stamps"];  // input.regularize_stamps
   input["refused"] = refused;
   return input;
 }

@@ -32,6 +32,7 @@ inline constexpr auto kInputKeys = [](auto& v, InputOptions& o) {
   v.Integer("max_line_length", o.max_line_length, 1);
   v.Number("max_time_jump_s", o.max_time_jump, kNoUnit, NonNegative());
   v.Number("reorder_window_s", o.reorder_window, kNoUnit, Within(0.0, 60.0));
+  v.Boolean("regularize_stamps", o.regularize_stamps);
 };
 
 inline constexpr auto kImuKeys = [](auto& v, ImuOptions& o) {

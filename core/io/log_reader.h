@@ -71,6 +71,8 @@ struct InputOptions {
                                      // damage (time_jump); 0 = no limit
   double reorder_window = 0.1;       // input.reorder_window_s: a record this much older than the newest is
                                      // sorted into place; older ones are out_of_order
+  bool regularize_stamps = true;     // input.regularize_stamps: IMU and wheel stamps put back on their
+                                     // sensor's grid when a logger jittered them (core/io/sample_clock.h)
   ImuRange imu_range;                // not an input.* key: the imu.* range (ReaderOptions)
 };
 

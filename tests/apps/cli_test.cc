@@ -415,6 +415,30 @@ TEST_F(CliRun, CrossStreamJitterRunsWithTheDefaultConfig) {
   }
 }
 
+// At rest nothing observes the GNSS time offset (its Jacobian is the velocity and the rate): estimated (the
+// default) over the drive's 10 s standstill alone, it keeps its prior's σ and stays within a tenth of it of
+// the prior's 0, in every estimator.
+TEST_F(CliRun, TheEstimatedOffsetHoldsStillAtRest) {
+  ASSERT_EQ(sim_exit_, 0);
+  const std::string cut = EditLines(test::ReadFile(log_), [](std::string* line) {
+    const size_t start = line->find(' ');
+    return line->rfind("#", 0) == 0 || std::stod(line->substr(start + 1)) < 1700000009.5;
+  });
+  const std::string log = dir_ + "/log_rest.txt", out = dir_ + "/out_rest";
+  test::WriteFile(log, cut);
+  ASSERT_EQ(RunCliInChild({"run", "--config", config_, "--log", log, "--out", out, "--mode", "all"}), 0);
+  const nlohmann::json s = Summary(out);
+  const nlohmann::json& est = s["estimators"];
+  for (const nlohmann::json* offset : {&est["eskf"]["time_offset"], &est["smoother"]["time_offset"],
+                                       &est["smoother"]["batch"]["time_offset"]}) {
+    SCOPED_TRACE(offset->dump());
+    EXPECT_TRUE((*offset)["estimated"].get<bool>());
+    // The noise of the rate and of the velocity at rest leaks in a trace (a few ms against the prior's 0.1 s).
+    EXPECT_GT((*offset)["final_sigma_s"].get<double>(), 0.099);
+    EXPECT_LT(std::abs((*offset)["final_s"].get<double>()), 0.1 * (*offset)["final_sigma_s"].get<double>());
+  }
+}
+
 // A logger that stamps the IMU and the wheels ±20 ms off their sensors' clocks over the whole log (lines in
 // the order written, stamps out of order): with the default config (input.regularize_stamps) the accuracy is
 // within 10 % (+1 cm) of the clean log's; without the regularisation, far worse.

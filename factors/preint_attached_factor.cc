@@ -43,6 +43,15 @@ Mat9x15 PredictionJacobian(const Preintegration& pre, const ImuEarthTerms& earth
   return J;
 }
 
+// One block's Jacobian (M rows) into Ceres's row-major array, when Ceres asks for it.
+template <typename Derived>
+void WriteJacobian(const Eigen::MatrixBase<Derived>& J, double* out) {
+  constexpr int R = Derived::RowsAtCompileTime, C = Derived::ColsAtCompileTime;
+  if (out == nullptr) return;
+  Eigen::Map<Eigen::Matrix<double, R, C, C == 1 ? Eigen::ColMajor : Eigen::RowMajor>> block(out);
+  block = J;
+}
+
 // The measurement at kinematics k, its residual and its Jacobian in the right-perturbed (δp, δθ, δv) from Jets.
 template <class Measurement>
 Eigen::Matrix<double, Measurement::kResidualDim, 9> MeasureAt(const Measurement& measurement,
@@ -116,20 +125,9 @@ bool EvaluateAttached(const PreintAttachedFactor<Measurement>& factor, const Vec
     WriteAmbientPoseJacobian<M>(J.template middleCols<3>(kColP), J.template middleCols<3>(kColTheta), Quat(q_i),
                                 jacobians[0]);
   }
-  if (jacobians[1] != nullptr) {
-    Eigen::Map<Eigen::Matrix<double, M, 3, Eigen::RowMajor>> out(jacobians[1]);
-    out = J.template middleCols<3>(kColV);
-  }
-  if (jacobians[2] != nullptr) {
-    Eigen::Map<Eigen::Matrix<double, M, 6, Eigen::RowMajor>> out(jacobians[2]);
-    out = J.template middleCols<6>(kColBg);
-  }
-  if constexpr (kDelayed) {
-    if (jacobians[3] != nullptr) {
-      Eigen::Map<Eigen::Matrix<double, M, 1>> out(jacobians[3]);
-      out = J_meas.template rightCols<1>();
-    }
-  }
+  WriteJacobian(J.template middleCols<3>(kColV), jacobians[1]);
+  WriteJacobian(J.template middleCols<6>(kColBg), jacobians[2]);
+  if constexpr (kDelayed) WriteJacobian(J_meas.template rightCols<1>(), jacobians[3]);
   return true;
 }
 
@@ -162,14 +160,8 @@ bool DelayedAtKeyframeCostFunction<Measurement>::Evaluate(double const* const* p
     WriteAmbientPoseJacobian<M>(J.template middleCols<3>(kRowP), J.template middleCols<3>(kRowTheta), Quat(q),
                                 jacobians[0]);
   }
-  if (jacobians[1] != nullptr) {
-    Eigen::Map<Eigen::Matrix<double, M, 3, Eigen::RowMajor>> out(jacobians[1]);
-    out = J.template middleCols<3>(kRowV);
-  }
-  if (jacobians[2] != nullptr) {
-    Eigen::Map<Eigen::Matrix<double, M, 1>> out(jacobians[2]);
-    out = J.template rightCols<1>();
-  }
+  WriteJacobian(J.template middleCols<3>(kRowV), jacobians[1]);
+  WriteJacobian(J.template rightCols<1>(), jacobians[2]);
   return true;
 }
 

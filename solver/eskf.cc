@@ -21,10 +21,10 @@ constexpr int kTd = eskf::Offset(Block::kTd);
 
 namespace {
 
-bool ScaleEstimated(const EstimatorOptions& o) { return o.wheel.enabled && o.wheel.estimate_scale; }
-
 // Whether any passive block (δs, td) has a variance: if none, their rows and columns of P are zero for good.
-bool PassiveEstimated(const EstimatorOptions& o) { return ScaleEstimated(o) || o.gnss.estimate_time_offset; }
+bool PassiveEstimated(const EstimatorOptions& o) {
+  return OdometerScaleEstimated(o) || o.gnss.estimate_time_offset;
+}
 
 }  // namespace
 
@@ -86,7 +86,7 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   // Across an IMU gap, coast: no rotation, no acceleration (the held sample says nothing about the gap). The
   // gap is judged from the newest sample, whatever the state's time, and a step no sample covers (a fix
   // after the initialisation, before the first sample) coasts too: the state always reaches t.
-  const bool gap = held == nullptr || t - last_sample_t_ > options_.imu.max_gap;
+  const bool gap = held == nullptr || PastImuGap(t);
   const Vec3 g_w = gravity();
   const Vec3& rate_w = earth_.rate_w();
   const Vec3 omega = gap ? Vec3(nom_.x.q_wb.conjugate() * rate_w) : Vec3(held->gyro - nom_.x.bg);
@@ -208,7 +208,7 @@ void Eskf::SetAdditivePriors() {
   if (options_.eskf.estimate_gravity) {
     BlockOf<Block::kG>(P_).diagonal().setConstant(options_.eskf.gravity_sigma * options_.eskf.gravity_sigma);
   }
-  if (ScaleEstimated(options_)) {
+  if (OdometerScaleEstimated(options_)) {
     P_(eskf::kS, eskf::kS) = options_.wheel.scale_sigma * options_.wheel.scale_sigma;
   }
   if (options_.gnss.estimate_time_offset) {
@@ -221,7 +221,7 @@ void Eskf::AddRandomWalks(double dt) {
   const double qba = options_.imu.acc_bias_rw * options_.imu.acc_bias_rw * dt;
   BlockOf<Block::kBg>(P_).diagonal().array() += qbg;
   BlockOf<Block::kBa>(P_).diagonal().array() += qba;
-  if (ScaleEstimated(options_)) {
+  if (OdometerScaleEstimated(options_)) {
     P_(eskf::kS, eskf::kS) += options_.wheel.scale_rw * options_.wheel.scale_rw * dt;
   }
   if (options_.gnss.estimate_time_offset) {
@@ -234,7 +234,7 @@ void Eskf::AddImu(const ImuSample& imu) {
   if (imu.t < nom_.x.t) return;  // samples before the initialisation epoch were used by the initialiser
   // Before the first sample after the initialisation, its epoch is the newest sample (a dropout right after
   // it is a gap as any other).
-  if (imu.t - last_sample_t_ > options_.imu.max_gap) imu_gaps_.Add(last_sample_t_, imu.t);
+  if (PastImuGap(imu.t)) imu_gaps_.Add(last_sample_t_, imu.t);
   const ImuSample mid = last_imu_ ? HeldBetween(*last_imu_, imu) : imu;
   Propagate(imu.t, &mid);
   last_imu_ = imu;

@@ -84,6 +84,8 @@ class Eskf : public Estimator {
   StateEstimate Estimate() const;
 
  private:
+  // Whether t lies beyond an IMU gap from the newest sample (imu.max_gap_s): there the state coasts.
+  bool PastImuGap(double t) const { return t - last_sample_t_ > options_.imu.max_gap; }
   // Propagates nominal state and covariance to time t with the given rate and specific force held
   // (default: the last IMU sample).
   void Propagate(double t, const ImuSample* held = nullptr);

@@ -26,11 +26,6 @@ Eigen::Quaternion<T> Rotated(const NavState& x, const Eigen::Matrix<T, 3, 1>& d_
   return x.q_wb.cast<T>() * ExpQuat<T>(d_theta);
 }
 
-// Whether the state at t coasts through an IMU gap: then nothing ties the offset to the motion (the coast's
-// constant velocity is not the vehicle's), and a fix's innovation would go into it as a lag. Its Jacobian
-// is then left out, as for a held offset.
-bool Coasting(double t, double last_sample_t, const ImuOptions& imu) { return t - last_sample_t > imu.max_gap; }
-
 // The state at the GNSS record's measurement time, t − td (core/time_shift.h), perturbed by (δp, δθ, δv, δtd).
 template <typename T>
 ShiftedKinematics<T> ShiftedState(const NavState& x, double td, const Vec3& a_w, const Vec3& omega_b,
@@ -81,7 +76,7 @@ bool Eskf::UpdateGnssPosition(const GnssMeasurement& m) {
           return GnssPositionModel::Residual<T>(k.p_wb, k.q_wb, options_.gnss.lever_b, m.p_w);
         },
         &r, &H);
-    if (Coasting(nom_.x.t, last_sample_t_, options_.imu)) H.rightCols<1>().setZero();
+    if (PastImuGap(nom_.x.t)) H.rightCols<1>().setZero();  // a coast says nothing of the offset
     return Linearized<3>{r, EmbedJacobian<3>({{Block::kP, H.leftCols<3>()},
                                               {Block::kTheta, H.middleCols<3>(3)},
                                               {Block::kV, H.middleCols<3>(6)},
@@ -115,7 +110,7 @@ void Eskf::UpdateHeading(const GnssMeasurement& m) {
           return Eigen::Matrix<T, 1, 1>(HeadingModel::Residual<T>(k.q_wb, options_.gnss.mount_yaw, m.yaw_G));
         },
         &r, &H);
-    if (Coasting(nom_.x.t, last_sample_t_, options_.imu)) H.rightCols<1>().setZero();
+    if (PastImuGap(nom_.x.t)) H.rightCols<1>().setZero();  // a coast says nothing of the offset
     return Linearized<1>{r, EmbedJacobian<1>({{Block::kTheta, H.leftCols<3>()}, {Block::kTd, H.rightCols<1>()}})};
   };
   Update<1>(model, Eigen::Matrix<double, 1, 1>(m.sigma_yaw * m.sigma_yaw), gate_heading_, &heading_counts_, m.t);
@@ -138,7 +133,7 @@ void Eskf::AddGvel(const GvelMeasurement& m) {
           return GnssVelocityModel::Residual<T>(k.q_wb, k.v_w, omega_b, options_.gnss.lever_b, m.v_w);
         },
         &r, &H);
-    if (Coasting(nom_.x.t, last_sample_t_, options_.imu)) H.rightCols<1>().setZero();
+    if (PastImuGap(nom_.x.t)) H.rightCols<1>().setZero();  // a coast says nothing of the offset
     return Linearized<3>{r, EmbedJacobian<3>({{Block::kV, H.leftCols<3>()},
                                               {Block::kTheta, H.middleCols<3>(3)},
                                               {Block::kTd, H.rightCols<1>()}})};

@@ -39,7 +39,6 @@ void BiasFromNav(const NavState& x, double* values) {
   bg = x.bg;
   ba = x.ba;
 }
-bool ScaleEstimated(const EstimatorOptions& options) { return options.wheel.enabled && options.wheel.estimate_scale; }
 double ScalePriorSigma(const EstimatorOptions& options) { return options.wheel.scale_sigma; }
 ceres::CostFunction* BiasRandomWalk(const EstimatorOptions& options, double dt) {
   return BiasRwFactor::Create(options.imu.gyro_bias_rw, options.imu.acc_bias_rw, dt);

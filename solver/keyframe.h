@@ -70,8 +70,6 @@ void VelocityToNav(const double* values, NavState* x);
 void VelocityFromNav(const NavState& x, double* values);
 void BiasToNav(const double* values, NavState* x);
 void BiasFromNav(const NavState& x, double* values);
-// The odometer scale is estimated only with wheels and wheel.estimate_scale.
-bool ScaleEstimated(const EstimatorOptions& options);
 double ScalePriorSigma(const EstimatorOptions& options);
 double ScaleRandomWalkSigma(const EstimatorOptions& options);
 ceres::CostFunction* BiasRandomWalk(const EstimatorOptions& options, double dt);
@@ -100,7 +98,7 @@ inline constexpr std::array<BlockSpec, kNumBlockTypes> kBlockSpecs = {{
     {BlockType::kScale, "scale", 1, 1, BlockKind::kEuclidean,
      0, {},
      nullptr, nullptr,
-     &keyframe_blocks::ScaleEstimated, 1.0, &keyframe_blocks::ScalePriorSigma, &keyframe_blocks::ScaleRandomWalk,
+     &OdometerScaleEstimated, 1.0, &keyframe_blocks::ScalePriorSigma, &keyframe_blocks::ScaleRandomWalk,
      &keyframe_blocks::ScaleRandomWalkSigma},
     {BlockType::kTimeOffset, "time_offset", 1, 1, BlockKind::kEuclidean,
      0, {},

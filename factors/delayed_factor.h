@@ -50,8 +50,8 @@ class DelayedAtKeyframeFactor {
     return true;
   }
 
-  // The production cost function: DelayedAtKeyframeCostFunction (the model's Jacobian in the tangent from
-  // Jets, lifted to the ambient pose).
+  // The production cost function: DelayedAtKeyframeCostFunction (the model's Linearize and the shift's
+  // Jacobian in the tangent, lifted to the ambient pose).
   static ceres::CostFunction* Create(Delayed<Measurement> delayed);
   // AutoDiffCostFunction<DelayedAtKeyframeFactor, kResidualDim, 7, 3, 1> of the same residual: the test oracle.
   static ceres::CostFunction* CreateAutoDiff(Delayed<Measurement> delayed);

@@ -52,29 +52,13 @@ void WriteJacobian(const Eigen::MatrixBase<Derived>& J, double* out) {
   block = J;
 }
 
-// The measurement at kinematics k, its residual and its Jacobian in the right-perturbed (δp, δθ, δv) from Jets.
+// The measurement at kinematics k, its residual and its Jacobian in the right-perturbed (δp, δθ, δv): the
+// model's own (Linearize, checked against autodiff of its residual by the factors' tests).
 template <class Measurement>
 Eigen::Matrix<double, Measurement::kResidualDim, 9> MeasureAt(const Measurement& measurement,
                                                               const PredictedKinematics<double>& k,
                                                               double* residuals) {
-  constexpr int M = Measurement::kResidualDim;
-  using Jet = ceres::Jet<double, 9>;
-  PredictedKinematics<Jet> kj;
-  Eigen::Matrix<Jet, 3, 1> dtheta;
-  for (int c = 0; c < 3; ++c) {
-    kj.p[c] = Jet(k.p[c], kRowP + c);
-    dtheta[c] = Jet(0.0, kRowTheta + c);
-    kj.v[c] = Jet(k.v[c], kRowV + c);
-  }
-  kj.q = k.q.cast<Jet>() * ExpQuat<Jet>(dtheta);
-  Jet r[M];
-  measurement(kj, r);
-  Eigen::Matrix<double, M, 9> J_meas;
-  for (int i = 0; i < M; ++i) {
-    residuals[i] = r[i].a;
-    J_meas.row(i) = r[i].v.transpose();
-  }
-  return J_meas;
+  return measurement.Linearize(k, residuals);
 }
 
 // The same at k's time − td (Delayed, core/time_shift.h), in (δp, δθ, δv, td): the model's Jacobian at the
@@ -86,15 +70,17 @@ Eigen::Matrix<double, Measurement::kResidualDim, 10> MeasureDelayedAt(const Dela
                                                                       double td, double* residuals) {
   const ShiftedKinematics<double> s = ShiftBack<double>(k.p, k.v, k.q, d.a_w, d.omega_b, td);
   const auto J_s = MeasureAt(d.measurement, PredictedKinematics<double>{s.p_wb, s.v_w, s.q_wb}, residuals);
-  Eigen::Matrix<double, 9, 10> S = Eigen::Matrix<double, 9, 10>::Zero();
-  S.block<3, 3>(kRowP, kRowP).setIdentity();
-  S.block<3, 3>(kRowP, kRowV) = -td * Mat3::Identity();
-  S.block<3, 3>(kRowTheta, kRowTheta) = ExpMat(d.omega_b * td);
-  S.block<3, 3>(kRowV, kRowV).setIdentity();
-  S.block<3, 1>(kRowP, 9) = -k.v + d.a_w * td;
-  S.block<3, 1>(kRowTheta, 9) = -d.omega_b;
-  S.block<3, 1>(kRowV, 9) = -d.a_w;
-  return J_s * S;
+  // J_s·S column block by column block (S is sparse: a dense 9×10 product costs more than the model).
+  constexpr int M = Measurement::kResidualDim;
+  Eigen::Matrix<double, M, 10> J;
+  const auto J_p = J_s.template middleCols<3>(kRowP);
+  const auto J_theta = J_s.template middleCols<3>(kRowTheta);
+  const auto J_v = J_s.template middleCols<3>(kRowV);
+  J.template middleCols<3>(kRowP) = J_p;
+  J.template middleCols<3>(kRowTheta) = J_theta * ExpMat(d.omega_b * td);
+  J.template middleCols<3>(kRowV) = J_v - td * J_p;
+  J.col(9) = J_p * (d.a_w * td - k.v) - J_theta * d.omega_b - J_v * d.a_w;
+  return J;
 }
 
 // The measurement at the state predicted at its stamp t (kDelayed: at t − td, td the fourth block), its

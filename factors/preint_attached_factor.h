@@ -13,6 +13,7 @@
 #include <ceres/cost_function.h>
 #include <ceres/sized_cost_function.h>
 
+#include <cmath>
 #include <memory>
 #include <utility>
 
@@ -21,6 +22,7 @@
 #include "core/gvel_model.h"
 #include "core/heading_model.h"
 #include "core/preintegration.h"
+#include "core/so3.h"
 #include "factors/pose_manifold.h"
 
 namespace gins {
@@ -33,6 +35,14 @@ struct GnssAtTime {
     Eigen::Map<Eigen::Matrix<T, 3, 1>> out(residual);
     out = GnssPositionModel::Residual<T>(k.p, k.q, lever_b, z_w).cwiseProduct(inv_sigma.cast<T>());
   }
+  // The residual and its Jacobian in the right-perturbed (δp, δθ, δv): d(R·Exp(δθ)·l) = −R·[l]×·δθ.
+  Eigen::Matrix<double, 3, 9> Linearize(const PredictedKinematics<double>& k, double* residual) const {
+    operator()(k, residual);
+    Eigen::Matrix<double, 3, 9> J = Eigen::Matrix<double, 3, 9>::Zero();
+    J.leftCols<3>() = inv_sigma.asDiagonal();
+    J.middleCols<3>(3) = inv_sigma.asDiagonal() * (k.q.toRotationMatrix() * Hat<double>(-lever_b));
+    return J;
+  }
 };
 
 struct HeadingAtTime {
@@ -41,6 +51,18 @@ struct HeadingAtTime {
   template <typename T>
   void operator()(const PredictedKinematics<T>& k, T* residual) const {
     residual[0] = HeadingModel::Residual<T>(k.q, mount_yaw, yaw_meas) * T(inv_sigma);
+  }
+  // The same, with its Jacobian: with x = R·x_G (the antenna axis in w), d atan2(x_y, x_x) = (x_x·dx_y −
+  // x_y·dx_x) / (x_x² + x_y²) and dx = −R·[x_G]×·δθ (the wrap is a constant).
+  Eigen::Matrix<double, 1, 9> Linearize(const PredictedKinematics<double>& k, double* residual) const {
+    operator()(k, residual);
+    const Mat3 R = k.q.toRotationMatrix();
+    const Vec3 x_G_b(std::cos(mount_yaw), std::sin(mount_yaw), 0.0);
+    const Vec3 x = R * x_G_b;
+    const Eigen::RowVector3d d_yaw_d_x = Eigen::RowVector3d(-x.y(), x.x(), 0.0) / (x.x() * x.x() + x.y() * x.y());
+    Eigen::Matrix<double, 1, 9> J = Eigen::Matrix<double, 1, 9>::Zero();
+    J.middleCols<3>(3) = -inv_sigma * d_yaw_d_x * R * Hat<double>(x_G_b);
+    return J;
   }
 };
 
@@ -51,6 +73,14 @@ struct GvelAtTime {
   void operator()(const PredictedKinematics<T>& k, T* residual) const {
     Eigen::Map<Eigen::Matrix<T, 3, 1>> out(residual);
     out = GnssVelocityModel::Residual<T>(k.q, k.v, omega_b, lever_b, z_w).cwiseProduct(inv_sigma.cast<T>());
+  }
+  // The same, with its Jacobian (as GnssAtTime's, with ω_b × lever_b for the lever and δv for δp).
+  Eigen::Matrix<double, 3, 9> Linearize(const PredictedKinematics<double>& k, double* residual) const {
+    operator()(k, residual);
+    Eigen::Matrix<double, 3, 9> J = Eigen::Matrix<double, 3, 9>::Zero();
+    J.middleCols<3>(3) = inv_sigma.asDiagonal() * (k.q.toRotationMatrix() * Hat<double>(lever_b.cross(omega_b)));
+    J.rightCols<3>() = inv_sigma.asDiagonal();
+    return J;
   }
 };
 
@@ -102,7 +132,7 @@ class PreintAttachedFactor {
 //   δθ_t = ΔRᵀ·δθ_i + Jr(φ)·(∂ΔR/∂bg)·δbg
 //   δv_t = δv_i − E2ᵀ·R_i·[Δv]×·δθ_i + E2ᵀ·R_i·(∂Δv/∂b)·δb − 2[ω]×·(δp_t − δp_i)
 // (A = (I + [ω]×T)⁻¹, E_k the Earth's turns; identities for the flat Earth), times the measurement's own
-// Jacobian in (δp_t, δθ_t, δv_t) from autodiff with 9-dimensional Jets (cheap: the model is a few lines).
+// Jacobian in (δp_t, δθ_t, δv_t), its Linearize (closed form).
 // The pose block's tangent Jacobian is lifted to the ambient one as ImuCostFunction does.
 template <class Measurement>
 class PreintAttachedCostFunction final

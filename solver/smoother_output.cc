@@ -178,10 +178,13 @@ bool WindowCovariances(KeyframeStore& store, int trailing, MatX* trailing_cov, M
       bool ok = positive(C);
       MatX C0;
       if (ok && oldest_cov != nullptr) {
-        MatX E = MatX::Zero(n, per);
-        E.topRows(per).setIdentity();
-        C0 = ldlt.solve(E).topRows(per);
-        ok = ldlt.info() == Eigen::Success && positive(C0);
+        // The oldest block the same way from the other end: (H⁻¹)_00 = Xᵀ·D⁻¹·X with X = L⁻¹·E, E its unit
+        // columns; one triangular solve, not the forward and backward pair of a full solve.
+        MatX X = MatX::Zero(n, per);
+        X.topRows(per).setIdentity();
+        ldlt.matrixL().solveInPlace(X);
+        C0 = X.transpose() * ldlt.vectorD().cwiseInverse().asDiagonal() * X;
+        ok = positive(C0);
       }
       if (ok) {
         *trailing_cov = symmetric(C);

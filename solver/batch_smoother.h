@@ -66,7 +66,7 @@ class BatchSmoother {
   void Emit(const FactorLog& log, const EarthModel& earth, const StateCallback& out) const;
 
   const BatchStats& stats() const { return stats_; }
-  // summary.json's "time_offset" (solver/estimator.h): the newest keyframe's, with its σ from the solution.
+  // summary.json's "time_offset" (solver/estimator_common.h): the newest keyframe's, with its σ from the solution.
   nlohmann::json TimeOffset() const;
 
  private:

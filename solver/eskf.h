@@ -13,7 +13,7 @@
 // (lever arm, every record) and the left/right difference as a yaw-rate aid (wheel.track_m), the
 // non-holonomic constraint at vehicle.nhc_rate_hz whether or not the log has wheels, standstill updates. A
 // run of rejected GNSS fixes that agree with one another inflates the gate and, when a fix is accepted under
-// it, the covariance it updates (GateInflation, solver/estimator.h): re-acquisition after an outage by design.
+// it, the covariance it updates (GateInflation, solver/estimator_common.h): re-acquisition after an outage by design.
 //
 // Robustness (config standstill.*, watchdog.*, imu.max_gap_s):
 // - Standstill (AddStandstill, from the session's detector): zero-velocity update (σ standstill.velocity_
@@ -43,6 +43,7 @@
 #include "solver/eskf_state.h"
 #include "solver/eskf_update.h"
 #include "solver/estimator.h"
+#include "solver/estimator_common.h"
 #include "solver/estimator_options.h"
 #include "solver/pre_init_output.h"
 

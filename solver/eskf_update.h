@@ -11,6 +11,7 @@
 
 #include "solver/eskf_state.h"
 #include "solver/estimator.h"
+#include "solver/estimator_common.h"
 
 namespace gins {
 namespace eskf {

@@ -1,4 +1,4 @@
-#include "solver/estimator.h"
+#include "solver/estimator_common.h"
 
 #include <algorithm>
 #include <cmath>

@@ -37,6 +37,7 @@
 #include "core/preintegration.h"
 #include "factors/pose_manifold.h"
 #include "solver/estimator.h"
+#include "solver/estimator_common.h"
 #include "solver/estimator_options.h"
 #include "solver/pre_init_output.h"
 #include "solver/factor_log.h"
@@ -68,6 +69,8 @@ class Smoother : public Estimator {
   NavState NewestState() const;
 
  private:
+  static constexpr double kSameEpoch = 1e-6;  // s: a fix at a keyframe's time belongs to it
+
   void IntegrateTo(double t, const ImuSample* held = nullptr);
   Keyframe& CreateKeyframe(double t);
   // The attachers' services (AttachContext): the prediction at t, and the keyframe policy's anchor.

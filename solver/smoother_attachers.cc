@@ -294,7 +294,7 @@ void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
     counts_.Reject("moving", kf.t);  // a quiet IMU at speed: not a stop
     return;
   }
-  // Nothing witnesses the stop (an outage without wheels): not while the estimate brakes (estimator.h).
+  // Nothing witnesses the stop (an outage without wheels): not while the estimate brakes (estimator_common.h).
   {
     const std::vector<BlockType> types = ctx.keyframes.EstimatedTypes();
     const MatX pose = SubCovariance(types, pred.cov, {BlockType::kPose});
@@ -328,7 +328,7 @@ void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
   if (ctx.keyframes.size() < 2) return;
   Keyframe& prev = ctx.keyframes[ctx.keyframes.size() - 2];
   if (standing_.count(prev.id) == 0 || prev.t < s.since) return;  // (kf's zero velocity is new: joined once)
-  // The rotation stands only where the gyro agrees (estimator.h, kZeroRateGateProbability): its mean over
+  // The rotation stands only where the gyro agrees (estimator_common.h, kZeroRateGateProbability): its mean over
   // the interval, less the bias and the Earth's rate, within its noise and the bias's σ.
   Vec3 integral = Vec3::Zero();
   double span = 0.0;

@@ -12,7 +12,7 @@
 //
 // The attachers here:
 // - GnssAttacher: position and dual-antenna heading; a run of rejected fixes that agree with one another
-//   inflates the gate (GateInflation, solver/estimator.h), and a fix accepted under it relieves the prior.
+//   inflates the gate (GateInflation, solver/estimator_common.h), and a fix accepted under it relieves the prior.
 // - GvelAttacher: GNSS (Doppler) velocity.
 // - StandstillAttacher: from the session's detector, a zero-velocity factor on each keyframe inside a
 //   standstill (checked against the predicted velocity, not above standstill.max_speed_m_s), and a
@@ -33,6 +33,7 @@
 
 #include "core/earth.h"
 #include "solver/estimator.h"
+#include "solver/estimator_common.h"
 #include "solver/keyframe.h"
 
 namespace gins {

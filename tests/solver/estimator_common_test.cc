@@ -1,5 +1,5 @@
-// The estimators' shared bookkeeping (solver/estimator.h).
-#include "solver/estimator.h"
+// The estimators' shared bookkeeping (solver/estimator_common.h).
+#include "solver/estimator_common.h"
 
 #include <gtest/gtest.h>
 

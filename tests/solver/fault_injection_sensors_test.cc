@@ -130,7 +130,7 @@ TEST(FaultInjection, HeadingValidButConstant) {
 }
 
 // The logger pauses: no record of any type for 1, 2, 5, 10 and 60 s while driving (from 50 s). Expected: both
-// coast across the IMU gap (counted) with the uncertainty of an unknown motion (estimator.h, kImuGap*); at
+// coast across the IMU gap (counted) with the uncertainty of an unknown motion (estimator_common.h, kImuGap*); at
 // the first fix after it the position σ has grown past the fixes' error, so the fix is taken (after 60 s,
 // past watchdog.max_position_sigma_m: a re-initialisation from it, the lost yaw from the dual-antenna
 // heading); within the bound 5 s after the records return.

@@ -183,7 +183,7 @@ TEST_P(ImuGrades, EveryOutputHoldsWithTheTrueSpecs) {
 
 // Standing is not the same as not turning: a vehicle stopped and turning in place at 0.4 deg/s for 20 s (an
 // IMU as quiet as at rest; the fixes and the zero speed say it stands). The smoother keeps the translation
-// still but the rotation free where the gyro disagrees with a zero rate (estimator.h, the zero-rate check):
+// still but the rotation free where the gyro disagrees with a zero rate (estimator_common.h, the zero-rate check):
 // no fix rejected, the yaw through the turn as good as the ESKF's, both two-sided outputs within their
 // forward passes' error. Measured: window yaw max 0.13° (consumer) / 0.006° (navigation), rmse_h 9 / 5 mm.
 // Held still in rotation, the navigation-grade window took the 8° turn into its gyro bias, rejected the fixes
@@ -222,7 +222,7 @@ TEST(ImuGrades, TurningInPlaceAtAStandstillIsNotHeldStill) {
 // A stop inside an outage with nothing to witness it (no wheels, no GNSS): the consumer-grade car brakes at
 // 1.6 m/s² to a standstill 20 s into a 27 s outage. Smooth braking is as quiet to an IMU as rest; a zero
 // velocity taken before the stop would move the position by the outage's position-velocity correlation
-// (estimator.h, AcceleratingWithoutWitness). Expected: the zero velocities during the braking refused as
+// (estimator_common.h, AcceleratingWithoutWitness). Expected: the zero velocities during the braking refused as
 // accelerating in both estimators, no fix rejected when the GNSS returns, and the drift over the outage
 // within twice what was measured: ESKF 1.25 m, window 0.41 m (taking them, 17.7 m and 9.2 m).
 TEST(ImuGrades, AStopInAnOutageWithoutAWitnessWaitsForTheStop) {

@@ -20,6 +20,7 @@
 #include "core/io/trajectory_writer.h"
 #include "core/io/truth_reader.h"
 #include "solver/health.h"
+#include "solver/summary_keys.h"
 
 namespace gins {
 namespace {
@@ -105,18 +106,20 @@ nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nloh
   for (const auto& [k, v] : rs.skipped_lines) input["skipped_lines"][k] = v;
   input["first_time"] = session.first_time();
   input["last_time"] = session.last_time();
-  input["odom_ignored_wheel_disabled"] = session_stats["odom_ignored_wheel_disabled"];
-  input["gvel_unused"] = session_stats["gvel_unused"];
-  input["dropped_before_first_fix"] = session_stats["dropped_before_first_fix"];
-  input["rest_states_before_initialization"] = session_stats["rest_states_before_initialization"];
+  namespace k = summary_keys;
+  for (const char* key : {k::kOdomIgnoredWheelDisabled, k::kGvelUnused, k::kDroppedBeforeFirstFix,
+                          k::kRestStatesBeforeInitialization}) {
+    input[key] = session_stats.at(key);
+  }
   // The API's reorder buffer (input.reorder_window_s): records sorted into place, and those refused (a
   // log's late records are out_of_order damage above, so "refused" stays empty for a log).
   nlohmann::json refused = nlohmann::json::object();
   for (const api::Rejection& r : status.rejections) {
     if (r.source == "input") refused[r.measurement][r.reason] = r.count;
   }
-  input["reorder"] = {{"window_s", session_stats["session"]["reorder_window_s"]}, {"sorted", status.reordered}};
-  input["stamps"] = session_stats["session"]["stamps"];  // input.regularize_stamps
+  const nlohmann::json& api_session = session_stats.at(k::kSession);
+  input["reorder"] = {{"window_s", api_session.at(k::kReorderWindow)}, {"sorted", status.reordered}};
+  input["stamps"] = api_session.at(k::kStamps);  // input.regularize_stamps
   input["refused"] = refused;
   return input;
 }
@@ -128,11 +131,11 @@ nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nloh
 nlohmann::json FaultsJson(const nlohmann::json& summary, const nlohmann::json& session_stats) {
   nlohmann::json f;
   f["input_skipped"] = summary["input"]["skipped"];
-  f["imu_interval_jitter"] = session_stats.value("imu_interval_jitter", 0);
-  f["imu_rate_changes"] = session_stats.value("imu_rate_changes", 0);
-  f["imu_same_stamp"] = session_stats.value("imu_same_stamp", 0);
-  f["wheel_interval_jitter"] = session_stats.value("wheel_interval_jitter", 0);
-  f["wheel_gaps"] = session_stats.value("wheel_gaps", 0);
+  namespace k = summary_keys;
+  for (const char* key :
+       {k::kImuIntervalJitter, k::kImuRateChanges, k::kImuSameStamp, k::kWheelIntervalJitter, k::kWheelGaps}) {
+    f[key] = session_stats.at(key);
+  }
   f["gnss_gaps"] = summary["gnss_gaps"].size();
   f["estimators"] = nlohmann::json::object();
   for (const auto& [name, e] : summary["estimators"].items()) {
@@ -144,9 +147,10 @@ nlohmann::json FaultsJson(const nlohmann::json& summary, const nlohmann::json& s
         if (n > 0) r[type] = n;
       }
     }
-    f["estimators"][name] = {{"imu_gaps", e.value("imu_gaps", 0)},
-                             {"rejected", r},
-                             {"watchdog_resets", e.contains("watchdog") ? e["watchdog"].value("count", 0) : 0}};
+    f["estimators"][name] = {
+        {"imu_gaps", e.at(k::kImuGaps)},
+        {"rejected", r},
+        {"watchdog_resets", e.contains(k::kWatchdog) ? e[k::kWatchdog].at(k::kWatchdogCount) : nlohmann::json(0)}};
   }
   for (const auto& [name, o] : summary["outputs"].items()) {
     f["non_finite_skipped"][name] = o.value("non_finite_skipped", 0);

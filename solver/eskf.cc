@@ -12,6 +12,7 @@
 #include "core/linearize.h"
 #include "core/so3.h"
 #include "core/wheel_model.h"
+#include "solver/summary_keys.h"
 
 namespace gins {
 
@@ -388,7 +389,7 @@ nlohmann::json Eskf::Stats() const {
   nlohmann::json j;
   j["imu_steps"] = imu_steps_;
   imu_gaps_.ToJson(&j);
-  j["watchdog"] = watchdog_.ToJson();
+  j[summary_keys::kWatchdog] = watchdog_.ToJson();
   j["gnss_position"] = gnss_counts_.ToJson();
   j["gnss_heading"] = heading_counts_.ToJson();
   j["gnss_velocity"] = gvel_counts_.ToJson();

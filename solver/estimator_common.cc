@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/so3.h"
+#include "solver/summary_keys.h"
 
 namespace gins {
 
@@ -182,7 +183,7 @@ void ImuGapLog::Add(double last_sample, double next_sample) {
 }
 
 void ImuGapLog::ToJson(nlohmann::json* j) const {
-  (*j)["imu_gaps"] = count_;
+  (*j)[summary_keys::kImuGaps] = count_;
   (*j)["imu_gap_times"] = nlohmann::json::array();
   for (const auto& [a, b] : times_) (*j)["imu_gap_times"].push_back({a, b});
 }
@@ -225,7 +226,7 @@ void GnssWatchdog::Reset(double t, const std::string& reason) {
 nlohmann::json GnssWatchdog::ToJson() const {
   nlohmann::json resets = nlohmann::json::array();
   for (const Event& r : resets_) resets.push_back({{"time", r.t}, {"reason", r.reason}});
-  return {{"resets", resets}, {"count", count_}};
+  return {{"resets", resets}, {summary_keys::kWatchdogCount, count_}};
 }
 
 nlohmann::json TimeOffsetJson(const GnssOptions& gnss, double td, double sigma) {

@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "solver/summary_keys.h"
+
 namespace gins {
 namespace {
 
@@ -47,7 +49,8 @@ Health JudgeHealth(const nlohmann::json& est, uint64_t non_finite_states) {
       }
     }
   }
-  const uint64_t resets = est.contains("watchdog") ? Count(est["watchdog"], "count") : 0;
+  const uint64_t resets =
+      est.contains(summary_keys::kWatchdog) ? Count(est[summary_keys::kWatchdog], summary_keys::kWatchdogCount) : 0;
   if (resets > 0) {
     found.push_back({resets >= Health::kFailedResets ? "failed" : "degraded",
                      std::to_string(resets) + " watchdog re-initialisation" + (resets > 1 ? "s" : "")});

@@ -13,6 +13,7 @@
 
 #include "core/gnss_noise.h"
 #include "core/wheel_model.h"
+#include "solver/summary_keys.h"
 
 namespace gins {
 namespace {
@@ -429,16 +430,17 @@ void Session::Finish() {
 
 nlohmann::json Session::Stats() const {
   nlohmann::json j;
-  j["odom_ignored_wheel_disabled"] = odom_ignored_;
-  j["gvel_unused"] = gvel_unused_;
-  j["imu_interval_jitter"] = imu_jitter_;
-  j["imu_rate_changes"] = imu_rate_changes_;
-  j["imu_same_stamp"] = imu_same_stamp_;
-  j["wheel_interval_jitter"] = wheel_jitter_;
-  j["wheel_gaps"] = wheel_gaps_;
-  j["dropped_before_first_fix"] = pending_dropped_;
+  namespace k = summary_keys;
+  j[k::kOdomIgnoredWheelDisabled] = odom_ignored_;
+  j[k::kGvelUnused] = gvel_unused_;
+  j[k::kImuIntervalJitter] = imu_jitter_;
+  j[k::kImuRateChanges] = imu_rate_changes_;
+  j[k::kImuSameStamp] = imu_same_stamp_;
+  j[k::kWheelIntervalJitter] = wheel_jitter_;
+  j[k::kWheelGaps] = wheel_gaps_;
+  j[k::kDroppedBeforeFirstFix] = pending_dropped_;
   j["standstill_updates"] = standstill_sent_;
-  j["rest_states_before_initialization"] = rest_sent_;
+  j[k::kRestStatesBeforeInitialization] = rest_sent_;
   if (!imu_warning_.empty()) j["warnings"] = {imu_warning_};
   if (options_.vehicle.nonholonomic) {
     const char* verdict = turn_check_.outcome() == TurnRateCheck::Outcome::kOk ? "ok" : "undecided";

@@ -13,6 +13,7 @@
 #include "solver/marginalizer.h"
 #include "solver/smoother_gate.h"
 #include "solver/smoother_output.h"
+#include "solver/summary_keys.h"
 #include "solver/vehicle_attacher.h"
 
 namespace gins {
@@ -437,7 +438,7 @@ nlohmann::json Smoother::Stats() const {
   j["final_odom_scale"] = last_scale_;
   j["time_offset"] = TimeOffsetJson(options_.gnss, final_time_offset_, final_time_offset_sigma_);
   imu_gaps_.ToJson(&j);
-  j["watchdog"] = watchdog_.ToJson();
+  j[summary_keys::kWatchdog] = watchdog_.ToJson();
   if (on_batch_) j["batch"] = batch_stats_;
   return j;
 }

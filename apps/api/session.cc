@@ -18,6 +18,7 @@
 #include "gins/gins.h"
 #include "solver/eskf.h"
 #include "solver/smoother.h"
+#include "solver/summary_keys.h"
 
 namespace gins::api {
 
@@ -222,7 +223,9 @@ Status Session::Impl::GetStatus() const {
         s.rejections.push_back({name, measurement, reason, n.get<uint64_t>()});
       }
     }
-    if (est.contains("watchdog")) s.watchdog_resets += est["watchdog"].value("count", uint64_t{0});
+    if (est.contains(summary_keys::kWatchdog)) {
+      s.watchdog_resets += est[summary_keys::kWatchdog].at(summary_keys::kWatchdogCount).get<uint64_t>();
+    }
   }
   return s;
 }
@@ -232,10 +235,10 @@ nlohmann::json Session::Impl::Stats() const {
   const std::lock_guard<std::mutex> lock(emit_mutex_);
   nlohmann::json rejected = nlohmann::json::object();
   for (const auto& [key, count] : rejected_) rejected[key.first][key.second] = count;
-  j["session"] = {{"accepted", accepted_},
-                  {"reorder_window_s", reorder_.window()},
+  j[summary_keys::kSession] = {{"accepted", accepted_},
+                  {summary_keys::kReorderWindow, reorder_.window()},
                   {"reordered", reorder_.reordered()},
-                  {"stamps",
+                  {summary_keys::kStamps,
                    {{"imu_regularized", imu_clock_.regularized()},
                     {"imu_max_correction_s", imu_clock_.max_correction()},
                     {"odom_regularized", odom_clock_.regularized()},

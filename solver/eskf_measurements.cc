@@ -42,12 +42,11 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
   Propagate(m.t);
   if (options_.watchdog.enabled) {
     FlushCovariance();
-    const double max_sigma = options_.watchdog.max_position_sigma;
     const bool finite = nom_.AllFinite() && P_.allFinite();
-    if (course_wait_.waiting() || !finite ||
-        BlockOf<Block::kP>(P_).diagonal().maxCoeff() > max_sigma * max_sigma) {
-      // A lost yaw waits for a later fix's course rather than being kept (ResetWaitsForCourse).
-      if (!(finite && course_wait_.Hold(m, &prev_fix_, options_, nom_.x, P_))) {
+    const double sigma_p = std::sqrt(BlockOf<Block::kP>(P_).diagonal().maxCoeff());
+    const FixVerdict verdict = WatchdogVerdict(m, finite, sigma_p, options_, nom_.x, P_, &course_wait_, &prev_fix_);
+    if (verdict != FixVerdict::kUse) {
+      if (verdict == FixVerdict::kReset) {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
         prev_fix_ = m;
       }

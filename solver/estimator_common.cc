@@ -69,6 +69,15 @@ bool CourseWait::Hold(const GnssMeasurement& m, std::optional<GnssMeasurement>* 
   return true;
 }
 
+FixVerdict WatchdogVerdict(const GnssMeasurement& m, bool finite, double sigma_p, const EstimatorOptions& options,
+                           const NavState& x, const Eigen::Ref<const MatX>& P, CourseWait* wait,
+                           std::optional<GnssMeasurement>* prev_fix) {
+  if (!options.watchdog.enabled) return FixVerdict::kUse;
+  if (!(wait->waiting() || !finite || sigma_p > options.watchdog.max_position_sigma)) return FixVerdict::kUse;
+  // A lost yaw waits for a later fix's course rather than being kept (ResetWaitsForCourse).
+  return finite && wait->Hold(m, prev_fix, options, x, P) ? FixVerdict::kHeld : FixVerdict::kReset;
+}
+
 std::string Describe(const FixReset& r) {
   std::string s = r.velocity_from_fixes ? "velocity from the last two fixes" : "velocity kept";
   if (std::string(r.yaw) == "heading") s += ", yaw from the dual-antenna heading";

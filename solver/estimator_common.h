@@ -192,4 +192,13 @@ class CourseWait {
   bool waiting_ = false;
 };
 
+// The watchdog's decision at fix m, before the fix is used, alike in both estimators: the estimate is lost
+// when it is not finite or its position 1-σ (sigma_p, m) is beyond watchdog.max_position_sigma, and stays
+// lost while a reset waits for a course (CourseWait). kUse: the fix is used as usual; kHeld: the reset waits,
+// m held for its course; kReset: the estimator re-initialises from m. Always kUse with the watchdog off.
+enum class FixVerdict { kUse, kHeld, kReset };
+FixVerdict WatchdogVerdict(const GnssMeasurement& m, bool finite, double sigma_p, const EstimatorOptions& options,
+                           const NavState& x, const Eigen::Ref<const MatX>& P, CourseWait* wait,
+                           std::optional<GnssMeasurement>* prev_fix);
+
 }  // namespace gins

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <cmath>
 
 #include "solver/estimator_common.h"
@@ -21,16 +22,16 @@ void Smoother::AddGnss(const GnssMeasurement& m) {
   if (!initialized_ || m.t < t_now_ - kSameEpoch || m.t < window_.back().t - kSameEpoch) return;
   if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
   if (options_.watchdog.enabled) {
-    const double max_sigma = options_.watchdog.max_position_sigma;
-    // The σ at the fix, predicted from the newest keyframe (the σ of the keyframe that left the window last,
-    // a window behind, lags a long gap by a window's time).
+    // The σ at the fix, predicted from the newest keyframe, and that of the keyframe that left the window
+    // last (a window behind, it lags a long gap by a window's time).
     const Prediction p = PredictAt(m.t);
     const Mat15 P = NavCovariance(window_.EstimatedTypes(), p.cov);
     const double sigma_p = std::sqrt(P.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
     const bool finite = window_.back().State().AllFinite() && pred_.AllFinite() && std::isfinite(sigma_p);
-    if (course_wait_.waiting() || !finite || last_sigma_p_ > max_sigma || sigma_p > max_sigma) {
-      // A lost yaw waits for a later fix's course rather than being kept (ResetWaitsForCourse).
-      if (!(finite && course_wait_.Hold(m, &prev_fix_, options_, p.x, P))) {
+    const FixVerdict verdict =
+        WatchdogVerdict(m, finite, std::max(sigma_p, last_sigma_p_), options_, p.x, P, &course_wait_, &prev_fix_);
+    if (verdict != FixVerdict::kUse) {
+      if (verdict == FixVerdict::kReset) {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
         prev_fix_ = m;
       }

@@ -20,13 +20,10 @@
 //   sigma_m_s) and zero-rate update (the mean gyro reading since the last standstill update observes the gyro
 //   bias); ignored while the estimated speed is above standstill.max_speed_m_s.
 // - IMU gap: a step longer than imu.max_gap_s (from the last IMU sample) is not integrated with the held
-//   sample: the state coasts (constant velocity and attitude) and the covariance grows as for an unknown
-//   acceleration of 2 m/s² and rotation rate of 10 deg/s held over the gap. Each gap is counted and listed.
-// - Watchdog: when every GNSS fix for watchdog.max_reject_s (at least 3 fixes) was rejected, or the position
-//   1-σ exceeds watchdog.max_position_sigma_m, or the state is not finite, the filter re-initialises from
-//   the current fix: position from the fix (1-σ: the fix's σ and 1 m), velocity from the last two fixes
-//   when they are at most 2 s apart (else kept; 1-σ 1 m/s), attitude and biases kept (yaw 1-σ at least
-//   2°); cross-covariances of position and velocity dropped. A glog WARNING and the summary
+//   sample: the state coasts (constant velocity and attitude) with the covariance of an unknown motion
+//   (kImuGap*, solver/estimator_common.h). Each gap is counted and listed.
+// - Watchdog: decided as in both estimators (GnssWatchdog, WatchdogVerdict: solver/estimator_common.h); the
+//   filter re-initialises from the current fix (ResetPositionFromFix there). A glog WARNING and the summary
 //   (watchdog.resets: time, reason) say so.
 #pragma once
 

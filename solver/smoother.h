@@ -19,11 +19,11 @@
 //   without the robust loss, so the window moves to where the fixes are (re-acquisition after an outage or
 //   a step of the GNSS positions by design, not by the watchdog).
 // - IMU gap longer than imu.max_gap_s: preintegrated as a coast (no rotation, no acceleration from the
-//   current estimate) with the covariance of an unknown 2 m/s² and 10 deg/s held over the gap.
-// - Watchdog: when every GNSS fix for watchdog.max_reject_s (at least 3) was rejected, or the last
-//   marginalised position 1-σ exceeds watchdog.max_position_sigma_m, or the newest state is not finite,
-//   the window is flushed to the output and rebuilt from a fresh prior at the current fix (position from
-//   the fix, velocity from the last two fixes, attitude, biases and scale kept), as the ESKF does.
+//   current estimate) with the covariance of an unknown motion (kImuGap*, solver/estimator_common.h).
+// - Watchdog: decided as in the ESKF (GnssWatchdog, WatchdogVerdict: solver/estimator_common.h; the position
+//   σ is the larger of the prediction at the fix and the last marginalised keyframe's): the window is flushed
+//   to the output and rebuilt from a fresh prior at the current fix (ResetPositionFromFix; the scale and the
+//   time offset kept).
 #pragma once
 
 #include <ceres/ceres.h>

@@ -35,13 +35,28 @@ std::vector<RunEntry> FindRuns(const std::vector<std::string>& inputs) {
       runs.push_back({input, (p / "summary.json").string()});
       continue;
     }
-    std::vector<std::string> found;
+    // A folder of runs: every directory below it that holds a summary.json is a run; every other directory
+    // with nothing below it is a run that failed (or is running): listed, as `DIR/*/` would list it.
+    std::vector<RunEntry> found;
+    std::vector<fs::path> leaves;
     for (const auto& e : fs::recursive_directory_iterator(p)) {
-      if (e.is_regular_file() && e.path().filename() == "summary.json") found.push_back(e.path().string());
+      if (e.is_regular_file() && e.path().filename() == "summary.json") {
+        found.push_back({e.path().parent_path().string(), e.path().string()});
+      } else if (e.is_directory() && fs::is_empty(e.path())) {
+        leaves.push_back(e.path());
+      }
     }
-    std::sort(found.begin(), found.end());
+    for (const fs::path& leaf : leaves) {
+      bool in_run = false;  // a run's own empty subfolder is not a run
+      for (const RunEntry& r : found) {
+        const std::string dir = r.run + "/";
+        in_run = in_run || leaf.string().compare(0, dir.size(), dir) == 0;
+      }
+      if (!in_run) found.push_back({leaf.string(), ""});
+    }
+    std::sort(found.begin(), found.end(), [](const RunEntry& a, const RunEntry& b) { return a.run < b.run; });
     if (found.empty()) runs.push_back({input, ""});
-    for (const std::string& f : found) runs.push_back({fs::path(f).parent_path().string(), f});
+    for (const RunEntry& r : found) runs.push_back(r);
   }
   return runs;
 }
@@ -74,21 +89,33 @@ std::string Tail(const std::string& s, size_t width) {
   return s.size() <= width ? s : "..." + s.substr(s.size() - (width - 3));
 }
 
+// A path as the table shows it: relative to the current folder when it lies below it (summaries store
+// absolute paths).
+std::string Shown(const std::string& path) {
+  std::error_code ec;
+  const fs::path cwd = fs::current_path(ec);
+  if (ec || path.empty() || path.front() != '/') return path;
+  const fs::path rel = fs::path(path).lexically_relative(cwd);
+  return rel.empty() || *rel.begin() == ".." ? path : rel.string();
+}
+
 void PrintTable(const nlohmann::json& rows) {
-  std::printf("%-24s %-24s %9s %-8s %11s %11s %11s %8s %8s %8s %7s\n", "run", "log", "log s", "mode", "eskf H m",
-              "smooth H m", "online H m", "rejected", "skipped", "watchdog", "RTF");
+  std::printf("%-24s %-24s %9s %-8s %11s %11s %11s %11s %11s %8s %8s %8s %7s\n", "run", "log", "log s", "mode",
+              "eskf H m", "smooth H m", "online H m", "batch H m", "rts H m", "rejected", "skipped", "watchdog", "RTF");
   for (const auto& r : rows) {
     if (r.contains("error")) {
       std::printf("%-24s %s\n", Tail(r["run"].get<std::string>(), 24).c_str(), r["error"].get<std::string>().c_str());
       continue;
     }
     const auto& h = r["rmse_horizontal_m"];
-    std::printf("%-24s %-24s %9s %-8s %11s %11s %11s %8llu %8llu %8llu %7s\n",
-                Tail(r["run"].get<std::string>(), 24).c_str(), Tail(r["log"].get<std::string>(), 24).c_str(),
+    std::printf("%-24s %-24s %9s %-8s %11s %11s %11s %11s %11s %8llu %8llu %8llu %7s\n",
+                Tail(r["run"].get<std::string>(), 24).c_str(), Tail(Shown(r["log"].get<std::string>()), 24).c_str(),
                 Fixed(r["duration_s"], "%.1f").c_str(), r["mode"].get<std::string>().c_str(),
                 Fixed(h.value("eskf", nlohmann::json()), "%.3f").c_str(),
                 Fixed(h.value("smoother", nlohmann::json()), "%.3f").c_str(),
                 Fixed(h.value("smoother_online", nlohmann::json()), "%.3f").c_str(),
+                Fixed(h.value("batch", nlohmann::json()), "%.3f").c_str(),
+                Fixed(h.value("eskf_rts", nlohmann::json()), "%.3f").c_str(),
                 static_cast<unsigned long long>(Count(r, "rejected")),
                 static_cast<unsigned long long>(Count(r, "skipped_lines")),
                 static_cast<unsigned long long>(Count(r, "watchdog_resets")),

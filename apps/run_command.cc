@@ -89,6 +89,13 @@ void CheckTruth(const std::string& path, const LocalEnuFrame& frame) {
   }
 }
 
+std::string AbsolutePath(const std::string& path) {
+  if (path.empty()) return path;
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::absolute(path, ec);
+  return ec ? path : p.lexically_normal().string();
+}
+
 // summary.json's "input": what was read and skipped.
 nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nlohmann::json& session_stats,
                          const api::Status& status) {
@@ -166,8 +173,9 @@ nlohmann::json RunSummary(const Options& options, const RunRequest& request, con
   nlohmann::json j;
   j["gins_version"] = api::Version();
   j["mode"] = request.mode;
-  j["config"] = request.config_path;
-  j["log"] = request.log_path;
+  // Absolute, so that the summary's readers (gins eval --summary, plot_run.py) find them from any folder.
+  j["config"] = AbsolutePath(request.config_path);
+  j["log"] = AbsolutePath(request.log_path);
   const GeodeticPoint& origin = session.frame()->origin();
   j["origin_lla"] = {origin.lat_deg, origin.lon_deg, origin.alt_m};
   j["gravity_m_s2"] = session.g_norm();
@@ -189,7 +197,7 @@ nlohmann::json RunSummary(const Options& options, const RunRequest& request, con
                             {"kept_before_initialization",
                              session_stats["gnss_outages"]["fixes_kept_before_initialization"]}};
   j["gnss_gaps"] = session_stats["gnss_outages"]["log_gaps"];
-  if (request.truth_path) j["truth"] = *request.truth_path;
+  if (request.truth_path) j["truth"] = AbsolutePath(*request.truth_path);
   j["gnss_lever_arm_m"] = {options.gnss.lever_b.x(), options.gnss.lever_b.y(), options.gnss.lever_b.z()};
   j["faults"] = FaultsJson(j, session_stats);
   if (session_stats.contains("warnings")) j["warnings"] = session_stats["warnings"];
@@ -231,6 +239,21 @@ void AddComparison(const RunRequest& request, const Session& session, const Stre
   for (const std::string& name : names) {
     const auto it = accuracy->find(name);
     (*j)["accuracy"][name] = AccuracyToJson(it == accuracy->end() ? nullptr : &it->second);
+  }
+}
+
+// A reused --out folder: the outputs an earlier run wrote there for estimators this run did not run are
+// removed once this run's are in place, so that the folder (and `gins eval` or `gins report` on it) shows
+// this run alone. Only gins's own output names are touched.
+void RemoveStaleOutputs(const std::string& dir, const Streams& streams) {
+  for (api::Stream stream : {api::Stream::kEskf, api::Stream::kSmoother, api::Stream::kSmootherOnline,
+                             api::Stream::kBatch, api::Stream::kEskfRts}) {
+    const std::string name = api::StreamName(stream);
+    if (streams.count(name) > 0) continue;
+    for (const std::string& file : {dir + "/" + name + ".tum", dir + "/" + name + "_states.csv"}) {
+      std::error_code ec;
+      std::filesystem::remove(file, ec);
+    }
   }
 }
 
@@ -337,6 +360,7 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
   for (auto& [name, s] : streams) {
     for (auto& f : s->Commit(request.out_dir)) result.outputs.push_back(f);
   }
+  RemoveStaleOutputs(request.out_dir, streams);
   result.summary = RunSummary(options, request, read_stats, session, streams, wall_start);
   AddComparison(request, internal, streams, &result.summary, &result.accuracy);
 

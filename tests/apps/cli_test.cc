@@ -247,6 +247,32 @@ TEST_F(CliRun, RunSmoother) {
   EXPECT_LT(acc["rmse_horizontal_m"].get<double>(), 0.05);
 }
 
+// A reused --out folder shows the newest run alone: an eskf run after an `all` run leaves no smoother, batch
+// or RTS file behind for `gins eval` to score beside it. The summary's paths are absolute, given relative
+// (its readers may start from any folder).
+TEST_F(CliRun, AReusedOutFolderHoldsTheNewestRunAloneWithAbsolutePaths) {
+  ASSERT_EQ(sim_exit_, 0);
+  const std::string out = dir_ + "/out_reused";
+  ASSERT_EQ(RunCliInChild({"run", "--config", config_, "--log", log_, "--out", out, "--mode", "all"}), 0);
+  EXPECT_TRUE(fs::exists(out + "/batch.tum"));
+  EXPECT_TRUE(fs::exists(out + "/eskf_rts_states.csv"));
+  const std::string log_relative = fs::relative(log_).string(), truth_relative = fs::relative(truth_).string();
+  ASSERT_NE(log_relative.front(), '/');
+  ASSERT_EQ(RunCliInChild({"run", "--config", config_, "--log", log_relative, "--out", out, "--mode", "eskf",
+                           "--truth", truth_relative}),
+            0);
+  for (const char* stale : {"smoother", "smoother_online", "batch", "eskf_rts"}) {
+    EXPECT_FALSE(fs::exists(out + "/" + stale + ".tum")) << stale;
+    EXPECT_FALSE(fs::exists(out + "/" + stale + "_states.csv")) << stale;
+  }
+  EXPECT_TRUE(fs::exists(out + "/eskf.tum"));
+  EXPECT_EQ(FilesIn(out), 3u);  // eskf.tum, eskf_states.csv, summary.json
+  const nlohmann::json s = Summary(out);
+  EXPECT_EQ(s["log"].get<std::string>(), fs::absolute(log_).lexically_normal().string());
+  EXPECT_EQ(s["truth"].get<std::string>(), fs::absolute(truth_).lexically_normal().string());
+  EXPECT_EQ(s["config"].get<std::string>().front(), '/');
+}
+
 // Without a truth the smoother's two outputs have nothing to be compared with (comparisons are against
 // the truth or the ESKF): the run does not read them back.
 TEST_F(CliRun, RunSmootherWithoutTruthComparesNothing) {

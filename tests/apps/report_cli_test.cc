@@ -69,6 +69,10 @@ TEST_F(ReportCliTest, OneRowPerRunWithItsNumbers) {
             0)
       << out;
   EXPECT_EQ(LinesStartingWith(out, "run ").size(), 1u) << out;
+  // A column per output, the two-sided ones of --mode all included.
+  for (const char* column : {"eskf H m", "smooth H m", "online H m", "batch H m", "rts H m"}) {
+    EXPECT_NE(LinesStartingWith(out, "run ").at(0).find(column), std::string::npos) << column;
+  }
   EXPECT_EQ(LinesStartingWith(out, "...").size() + LinesStartingWith(out, dir_).size(), 3u) << out;
   EXPECT_NE(out.find("3 runs, 0.15 h of log; 7 rejected, 3 skipped lines, 1 watchdog resets"), std::string::npos)
       << out;
@@ -103,6 +107,20 @@ TEST_F(ReportCliTest, FoldersAreSearchedAndRunsWithoutSummaryListed) {
   EXPECT_NE(out.find("1 runs, 0.05 h of log; 1 rejected, 0 skipped lines, 0 watchdog resets; 1 without a summary"),
             std::string::npos)
       << out;
+
+  // The folder of a fleet with a failed run (gins run leaves its --out folder empty): listed too, as
+  // `runs_mixed/*/` lists it, and the exit code says so; a run's own empty subfolder is not a run.
+  fs::create_directories(dir_ + "/runs_mixed");
+  fs::copy(dir_ + "/runs/a", dir_ + "/runs_mixed/a");
+  fs::create_directories(dir_ + "/runs_mixed/a/plots");
+  fs::create_directories(dir_ + "/runs_mixed/failed");
+  for (const std::string& inputs : {dir_ + "/runs_mixed", dir_ + "/runs_mixed/*/"}) {
+    EXPECT_EQ(Shell(kGins + " report " + inputs, dir_, &out), 1) << inputs;
+    EXPECT_EQ(LinesStartingWith(out, "...").size() + LinesStartingWith(out, dir_).size(), 2u) << out;
+    EXPECT_NE(out.find("1 runs, 0.05 h of log; 1 rejected, 0 skipped lines, 0 watchdog resets; 1 without a summary"),
+              std::string::npos)
+        << out;
+  }
 
   test::WriteFile(dir_ + "/runs_failed/bad.json", "{not json");
   EXPECT_EQ(Shell(kGins + " report " + dir_ + "/runs_failed/bad.json", dir_, &out), 1);

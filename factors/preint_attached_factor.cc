@@ -1,7 +1,6 @@
 #include "factors/preint_attached_factor.h"
 
 #include <ceres/autodiff_cost_function.h>
-#include <ceres/jet.h>
 #include <glog/logging.h>
 
 #include "core/so3.h"
@@ -52,24 +51,15 @@ void WriteJacobian(const Eigen::MatrixBase<Derived>& J, double* out) {
   block = J;
 }
 
-// The measurement at kinematics k, its residual and its Jacobian in the right-perturbed (δp, δθ, δv): the
-// model's own (Linearize, checked against autodiff of its residual by the factors' tests).
-template <class Measurement>
-Eigen::Matrix<double, Measurement::kResidualDim, 9> MeasureAt(const Measurement& measurement,
-                                                              const PredictedKinematics<double>& k,
-                                                              double* residuals) {
-  return measurement.Linearize(k, residuals);
-}
-
-// The same at k's time − td (Delayed, core/time_shift.h), in (δp, δθ, δv, td): the model's Jacobian at the
-// shifted state times the shift's, in closed form: δp_s = δp − td·δv, δv_s = δv, δθ_s = Exp(ω·td)·δθ, and in
-// td: −v + a·td, −a, −ω (the rotation's right Jacobian leaves its own axis as it is).
+// A measurement at k's time − td (Delayed, core/time_shift.h), in (δp, δθ, δv, td): the model's Jacobian
+// (Linearize) at the shifted state times the shift's, in closed form: δp_s = δp − td·δv, δv_s = δv,
+// δθ_s = Exp(ω·td)·δθ, and in td: −v + a·td, −a, −ω (the rotation's right Jacobian keeps its axis).
 template <class Measurement>
 Eigen::Matrix<double, Measurement::kResidualDim, 10> MeasureDelayedAt(const Delayed<Measurement>& d,
                                                                       const PredictedKinematics<double>& k,
                                                                       double td, double* residuals) {
   const ShiftedKinematics<double> s = ShiftBack<double>(k.p, k.v, k.q, d.a_w, d.omega_b, td);
-  const auto J_s = MeasureAt(d.measurement, PredictedKinematics<double>{s.p_wb, s.v_w, s.q_wb}, residuals);
+  const auto J_s = d.measurement.Linearize(PredictedKinematics<double>{s.p_wb, s.v_w, s.q_wb}, residuals);
   // J_s·S column block by column block (S is sparse: a dense 9×10 product costs more than the model).
   constexpr int M = Measurement::kResidualDim;
   Eigen::Matrix<double, M, 10> J;
@@ -101,7 +91,7 @@ bool EvaluateAttached(const PreintAttachedFactor<Measurement>& factor, const Vec
     J_meas = MeasureDelayedAt(Delayed<Measurement>{factor.measurement(), a_w, omega_b}, k, parameters[3][0],
                               residuals);
   } else {
-    J_meas = MeasureAt(factor.measurement(), k, residuals);
+    J_meas = factor.measurement().Linearize(k, residuals);
   }
   if (jacobians == nullptr) return true;
   const Eigen::Matrix<double, M, 9> J_state = J_meas.template leftCols<9>();

@@ -63,20 +63,41 @@ int DigitCount(uint64_t n) {
   return t + 1 - (n < kPow10U[t] ? 1 : 0);
 }
 
-// Digits of n, at least `min_digits` of them (zero-padded), into [first, last).
-char* WriteDigits(char* first, char* last, uint64_t n, int min_digits) {
-  const int k = std::max({DigitCount(n), min_digits, 1});
-  if (last - first < k) return nullptr;
-  // Exactly k digits, right to left: the leading zeros come out of n's own pairs (no padding pass).
+// Exactly k digits of n (n < 10^k, zero-padded) from `first`, right to left: the leading zeros come out of
+// n's own pairs. The hottest code of an IMU-rate output: four digits per division in 32 bits (a 64-bit one
+// only above 2^32, e.g. a time stamp's integer part), two per table look-up.
+inline char* WriteExactDigits(char* first, uint64_t n, int k) {
   char* p = first + k;
-  while (p - first >= 2) {
+  while (n > 0xffffffffULL && p - first >= 2) {
     const uint64_t pair = n % 100;
     n /= 100;
-    *--p = kDigitPairs[2 * pair + 1];
-    *--p = kDigitPairs[2 * pair];
+    p -= 2;
+    std::memcpy(p, kDigitPairs + 2 * pair, 2);
   }
-  if (p > first) *--p = static_cast<char>('0' + n % 10);
+  uint32_t m = static_cast<uint32_t>(n);
+  while (p - first >= 4) {
+    const uint32_t four = m % 10000;
+    m /= 10000;
+    p -= 4;
+    std::memcpy(p, kDigitPairs + 2 * (four / 100), 2);
+    std::memcpy(p + 2, kDigitPairs + 2 * (four % 100), 2);
+  }
+  if (p - first >= 2) {
+    const uint32_t pair = m % 100;
+    m /= 100;
+    p -= 2;
+    std::memcpy(p, kDigitPairs + 2 * pair, 2);
+  }
+  if (p > first) *--p = static_cast<char>('0' + m % 10);
   return first + k;
+}
+
+// Digits of n, at least `min_digits` of them (zero-padded), into [first, last).
+inline char* WriteDigits(char* first, char* last, uint64_t n, int min_digits) {
+  const int digits = DigitCount(n);
+  const int k = digits > min_digits ? digits : (min_digits > 1 ? min_digits : 1);
+  if (last - first < k) return nullptr;
+  return WriteExactDigits(first, n, k);
 }
 
 // "-"? ip "." fp (fp zero-padded to `precision` digits; no point when precision is 0). nullptr if too short.
@@ -87,9 +108,9 @@ char* WriteDecimal(char* p, char* last, bool negative, uint64_t ip, uint64_t fp,
   }
   p = WriteDigits(p, last, ip, 1);
   if (p == nullptr || precision == 0) return p;
-  if (p == last) return nullptr;
+  if (last - p < precision + 1) return nullptr;
   *p++ = '.';
-  return WriteDigits(p, last, fp, precision);
+  return WriteExactDigits(p, fp, precision);  // fp < 10^precision
 }
 
 }  // namespace

@@ -139,7 +139,7 @@ void Initializer::TrackStandstill(const ImuSample& imu) {
   const bool standing = detector_.Decide() == StandstillDetector::State::kStanding;
   if (standing && !standing_) {
     // The quiet stretch the witness vouches for, from its start (its samples are still buffered).
-    standing_.emplace();
+    standing_.emplace(Standstill{});  // (not emplace(): clang rejects the nested type's defaults there)
     standing_->summary.t_start = std::max(detector_.quiet_since(), imu_.front().t);
     standing_->witness = detector_.witness();
     for (const ImuSample& s : imu_) {

@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "apps/convert_command.h"
+#include "apps/export_command.h"
 #include "apps/eval_command.h"
 #include "apps/report_command.h"
 #include "apps/run_command.h"
@@ -149,6 +150,8 @@ int RunCli(int argc, const char* const* argv) {
   auto* stream = AddStreamCommand(app, &stream_req);
   ReportRequest report_req;  // gins report (apps/report_command.h)
   auto* report = AddReportCommand(app, &report_req);
+  ExportRequest export_req;  // gins export (apps/export_command.h)
+  auto* exp = AddExportCommand(app, &export_req);
 
   try {
     app.parse(argc, argv);
@@ -168,6 +171,7 @@ int RunCli(int argc, const char* const* argv) {
   if (*report) return RunReport(report_req);
   if (*eval) return RunEval(eval_req);
   if (*convert) return RunConvert(convert_req);
+  if (*exp) return RunExport(export_req);
   try {
     if (*run) {
       const api::Config config = api::Config::FromFile(config_path);

@@ -346,7 +346,7 @@ CLI::App* AddEvalCommand(CLI::App& app, EvalRequest* req) {
       "Accuracy of trajectories against a truth (--truth), or of estimates against the first one: RMSE 3-D, "
       "horizontal, vertical, velocity, attitude, heading; relative error over distance; drift over GNSS outages");
   eval->add_option("trajectories", req->inputs,
-                   "Trajectories: our .tum or *_states.csv (with the origin comment; .gz too), foreign TUM, or run "
+                   "Trajectories: our .tum or *_states.csv (its origin from the .tum beside it; .gz too), foreign TUM, or run "
                    "directories (their outputs and summary.json)")
       ->required();
   eval->add_option("--truth", req->truth_path, "Truth CSV (docs/formats.md §4; .gz too)")->check(CLI::ExistingFile);

@@ -30,24 +30,19 @@ using Clock = std::chrono::steady_clock;
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 // Writers of one output stream (e.g. "eskf"), created at its first state because the trajectory header
-// needs the world frame's origin. It is scored against a truth after the run, from the committed files
-// (AddComparison): the same code as `gins eval`, and memory that does not grow with the log.
+// needs the world frame's origin: its TUM file, its states CSV (all but smoother_online) and its geodetic
+// track. It is scored against a truth after the run, from the committed files (AddComparison): the same
+// code as `gins eval`, and memory that does not grow with the log.
 class OutputStream {
  public:
   OutputStream(const std::string& name, const std::string& dir, const LocalEnuFrame& frame, bool with_states)
-      : name_(name), tum_(dir + "/" + name + ".tum", name, frame.origin()) {
-    if (with_states) {
-      states_ = std::make_unique<StatesCsvWriter>(dir + "/" + name + "_states.csv", name, frame.origin());
-    }
+      : name_(name), tum_(dir + "/" + name + ".tum", name, frame.origin()),
+        lla_(dir + "/" + name + "_lla.csv", frame) {
+    if (with_states) states_ = std::make_unique<StatesCsvWriter>(dir + "/" + name + "_states.csv");
   }
 
   void Add(const StateEstimate& e) {
-    if (!filter_.Accept(e)) return;
-    if (states_) {
-      tum_.AddWithStates(states_.get(), e.x, e.sigma_p, e.sigma_v, e.sigma_att, e.odom_scale);
-    } else {
-      tum_.Add(e.x);
-    }
+    if (filter_.Accept(e)) tum_.AddWithStates(states_.get(), &lla_, e.x, e.sigma_p, e.sigma_v, e.sigma_att, e.odom_scale);
   }
 
   std::vector<std::string> Commit(const std::string& dir) {
@@ -58,6 +53,8 @@ class OutputStream {
       states_->Commit();
       files.push_back(dir + "/" + name_ + "_states.csv");
     }
+    lla_.Commit();
+    files.push_back(dir + "/" + name_ + "_lla.csv");
     return files;
   }
 
@@ -68,6 +65,7 @@ class OutputStream {
   std::string name_;
   TumWriter tum_;
   std::unique_ptr<StatesCsvWriter> states_;
+  GeodeticCsvWriter lla_;
   StateFilter filter_;
 };
 
@@ -250,7 +248,8 @@ void RemoveStaleOutputs(const std::string& dir, const Streams& streams) {
                              api::Stream::kBatch, api::Stream::kEskfRts}) {
     const std::string name = api::StreamName(stream);
     if (streams.count(name) > 0) continue;
-    for (const std::string& file : {dir + "/" + name + ".tum", dir + "/" + name + "_states.csv"}) {
+    for (const std::string& file :
+         {dir + "/" + name + ".tum", dir + "/" + name + "_states.csv", dir + "/" + name + "_lla.csv"}) {
       std::error_code ec;
       std::filesystem::remove(file, ec);
     }

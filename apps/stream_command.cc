@@ -15,6 +15,7 @@
 #include "apps/api/access.h"
 #include "apps/api/convert.h"
 #include "apps/run_command.h"
+#include "core/io/geo_export.h"
 #include "core/io/trajectory_writer.h"
 #include "gins/gins.h"
 
@@ -66,19 +67,44 @@ class StopSignals {
 // flushed as it is written.
 class StateLines {
  public:
-  StateLines(std::FILE* out, api::Stream stream, bool csv) : out_(out), stream_(stream), csv_(csv) {}
+  StateLines(std::FILE* out, api::Stream stream, const std::string& format, const NmeaExportOptions& nmea)
+      : out_(out), stream_(stream), format_(format), nmea_(nmea) {}
 
   void Add(const api::State& state, const api::Session& session) {
     if (state.stream != stream_) return;
     const StateEstimate e = api::ToStateEstimate(state);
     if (!filter_.Accept(e)) return;
+    const LocalEnuFrame& frame = *api::internal::Access::session(session).frame();
     if (written_ == 0) {
-      const GeodeticPoint& origin = api::internal::Access::session(session).frame()->origin();
-      std::fputs(TrajectoryHeader(api::StreamName(stream_), origin).c_str(), out_);
-      if (csv_) std::fputs(kStatesCsvColumns, out_);
+      // The CSVs start with their column names; the states CSV's origin goes to stderr (the TUM file's
+      // comment line carries it).
+      if (format_ == "tum") std::fputs(TrajectoryHeader(api::StreamName(stream_), frame.origin()).c_str(), out_);
+      if (format_ == "csv") {
+        std::fprintf(stderr, "gins stream: %s states in ENU, origin_lla=%.10f %.10f %.4f\n", api::StreamName(stream_),
+                     frame.origin().lat_deg, frame.origin().lon_deg, frame.origin().alt_m);
+        std::fputs(kStatesCsvColumns, out_);
+      }
+      if (format_ == "lla") std::fputs(kGeodeticCsvColumns, out_);
     }
-    if (csv_) {
+    if (format_ == "csv") {
       WriteStatesCsvLine(out_, e.x, e.sigma_p, e.sigma_v, e.sigma_att, e.odom_scale);
+    } else if (format_ == "lla") {
+      WriteGeodeticCsvLine(out_, frame, e.x, e.sigma_p);
+    } else if (format_ == "nmea") {
+      if (!OnNmeaGrid(e.x.t, nmea_.rate_hz, &next_nmea_t_)) return;
+      if (e.x.t < kMinAbsoluteTime) {
+        throw std::runtime_error("state at t=" + std::to_string(e.x.t) +
+                                 " s: not an absolute time, NMEA needs the UTC date and time (docs/formats.md §2.6)");
+      }
+      TrajectorySample s;
+      s.t = e.x.t;
+      s.p_w = e.x.p_wb;
+      s.q_wb = e.x.q_wb;
+      s.v_w = e.x.v_w;
+      s.sigma_p = e.sigma_p;
+      s.yaw_known = e.sigma_att.z() < kUnknownYawSigmaBound;
+      const GeoSample g = ToGeoSample(frame, s, SampleContent{true, true, true});
+      WriteNmeaEpoch(g, QualityOf({}, g), nmea_, out_);
     } else {
       WriteTumLine(out_, e.x);
     }
@@ -92,7 +118,9 @@ class StateLines {
  private:
   std::FILE* out_;
   api::Stream stream_;
-  bool csv_;
+  std::string format_;
+  NmeaExportOptions nmea_;
+  double next_nmea_t_ = -1e300;
   StateFilter filter_;
   uint64_t written_ = 0;
 };
@@ -120,7 +148,7 @@ CLI::App* AddStreamCommand(CLI::App& app, StreamRequest* req) {
   auto* stream = app.add_subcommand("stream", "Estimate from records on stdin, each state on stdout as it comes");
   stream->footer(
       "Reads the log format of `gins run` (plain text; zcat a .gz log) with the same damage policy and\n"
-      "writes the lines `gins run` writes to <stream>.tum (or _states.csv), each flushed as soon as the\n"
+      "writes the lines `gins run` writes to <stream>.tum (_states.csv, _lla.csv), each flushed as soon as the\n"
       "state is estimated: the ESKF's with the IMU sample, the smoother's final ones when their keyframe\n"
       "leaves the window (--online: its newest keyframe after each solve). Measurements that arrive out of\n"
       "order are sorted within input.reorder_window_s (which every state then waits for). Ends at the end of\n"
@@ -132,8 +160,17 @@ CLI::App* AddStreamCommand(CLI::App& app, StreamRequest* req) {
   stream->add_option("--mode", req->mode, "Estimator")
       ->check(CLI::IsMember({"eskf", "smoother"}))
       ->capture_default_str();
-  stream->add_option("--out-format", req->out_format, "tum: t x y z qx qy qz qw; csv: the full state with 1-σ")
-      ->check(CLI::IsMember({"tum", "csv"}))
+  stream->add_option("--out-format", req->out_format,
+                     "tum: t x y z qx qy qz qw; csv: the full state with 1-σ; lla: t, latitude, longitude, "
+                     "height with 1-σ; nmea: GGA, RMC, GST, HDT at --rate (docs/formats.md §5)")
+      ->check(CLI::IsMember({"tum", "csv", "lla", "nmea"}))
+      ->capture_default_str();
+  stream->add_option("--rate", req->rate_hz, "nmea: epochs per second (0: every state)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  stream->add_option("--time-scale", req->time_scale,
+                     "nmea: the log's times are gps (seconds since 1980-01-06, GPS time) or unix (UTC) seconds")
+      ->check(CLI::IsMember({"gps", "unix"}))
       ->capture_default_str();
   stream->add_flag("--online", req->online, "With --mode smoother: the causal estimate (smoother_online)");
   return stream;
@@ -153,7 +190,10 @@ int RunStream(const StreamRequest& req, int in_fd, std::FILE* out) {
     StopSignals signals;
     api::LogReader reader = api::LogReader::FromFd(in_fd, kInputName, config, signals.fd());
     api::Session session(config, session_options);
-    StateLines lines(out, stream, req.out_format == "csv");
+    NmeaExportOptions nmea;
+    nmea.rate_hz = req.rate_hz;
+    ParseLogTimeScale(req.time_scale, &nmea.time_scale);
+    StateLines lines(out, stream, req.out_format, nmea);
     session.OnState([&](const api::State& s) { lines.Add(s, session); });
 
     const double max_wait = api::internal::Access::options(config).init.max_wait;

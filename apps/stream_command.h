@@ -12,7 +12,10 @@ namespace gins {
 struct StreamRequest {
   std::string config_path;
   std::string mode = "eskf";       // eskf | smoother
-  std::string out_format = "tum";  // tum | csv: the lines of `gins run`'s <stream>.tum or <stream>_states.csv
+  std::string out_format = "tum";  // tum | csv | lla: the lines of `gins run`'s <stream>.tum, _states.csv,
+                                   // _lla.csv; nmea: `gins export`'s sentences (docs/formats.md §5.7)
+  double rate_hz = 1.0;            // nmea: epochs per second (0: every state)
+  std::string time_scale = "gps";  // nmea: what the log's times count
   bool online = false;             // smoother: its causal estimate (smoother_online), not its final one
 };
 

@@ -21,7 +21,7 @@ import sys
 
 import numpy as np
 
-from gins_geo import lla_to_enu, open_text, rot_enu_from_ecef  # noqa: E402
+from gins_geo import lla_to_enu, open_text, output_origin, rot_enu_from_ecef  # noqa: E402
 
 
 def yaw_of(qw, qx, qy, qz):
@@ -123,6 +123,8 @@ def read_trajectory(path):
                 rows.append([float(v) for v in fields])
             except ValueError:
                 cols = {name: i for i, name in enumerate(fields)}
+    if origin is None:  # a *_states.csv: its origin is in the TUM file beside it
+        origin, mode = output_origin(path)
     a = np.array(rows)
     if cols is None:
         t, p, q, v = a[:, 0], a[:, 1:4], a[:, [7, 4, 5, 6]], None

@@ -18,6 +18,27 @@ def open_text(path):
     return gzip.open(path, "rt") if magic == b"\x1f\x8b" else open(path, "rt")
 
 
+def output_origin(path):
+    """(origin (lat, lon, alt) or None, mode) of a gins output: from its first comment line (TUM files), or
+    for a *_states.csv, which starts with its column names, from the TUM file beside it."""
+    candidates = [path]
+    for suffix in ("_states.csv", "_states.csv.gz"):
+        if path.endswith(suffix):
+            stem = path[:-len(suffix)]
+            candidates += [stem + ".tum", stem + ".tum.gz"]
+    for c in candidates:
+        try:
+            with open_text(c) as f:
+                first = f.readline()
+        except OSError:
+            continue
+        if first.startswith("#") and "origin_lla=" in first:
+            origin = [float(v) for v in first.split("origin_lla=")[1].split()[:3]]
+            mode = first.split("mode=")[1].split()[0] if "mode=" in first else ""
+            return origin, mode
+    return None, ""
+
+
 def lla_to_ecef(lat, lon, alt):
     lat, lon = np.radians(lat), np.radians(lon)
     n = A / np.sqrt(1 - E2 * np.sin(lat) ** 2)

@@ -19,7 +19,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gins_geo import lla_to_enu  # noqa: E402
+from gins_geo import lla_to_enu, output_origin  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GINS = os.path.join(ROOT, "build", "gins")
@@ -62,10 +62,8 @@ def run_config(grade):
 
 
 def nees_and_errors(states_csv, truth, t0):
-    with open(states_csv) as f:
-        header = f.readline()
-    origin = [float(x) for x in header.split("origin_lla=")[1].split()]
-    d = np.genfromtxt(states_csv, delimiter=",", skip_header=1, names=True)
+    origin, _ = output_origin(states_csv)
+    d = np.genfromtxt(states_csv, delimiter=",", names=True)
     tp = lla_to_enu(truth["lat"], truth["lon"], truth["alt"], origin)
     idx = np.clip(np.searchsorted(truth["t"], d["t"]), 0, len(truth) - 1)
     ok = np.abs(truth["t"][idx] - d["t"]) < 1e-3

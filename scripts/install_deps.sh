@@ -1,8 +1,18 @@
 #!/usr/bin/env bash
-# Installs the Debian packages gins needs that are not installed yet (run as root on Debian 12). Extra
-# arguments are further packages wanted (the benchmark scripts add libbenchmark-dev and time).
+# Installs the Debian packages gins needs that are not installed yet (run as root on Debian 12). --test adds
+# the clients the test suite opens gins's outputs with; other arguments are further packages wanted (the
+# benchmark scripts add libbenchmark-dev and time).
 set -euo pipefail
-packages=("$@"
+extra=()
+for a in "$@"; do
+  if [ "$a" = --test ]; then
+    # tests/apps/export_clients_test.py: GDAL's ogrinfo (KML, GPX, GeoJSON), pynmea2, pandas.
+    extra+=(gdal-bin python3-nmea2 python3-pandas)
+  else
+    extra+=("$a")
+  fi
+done
+packages=("${extra[@]}"
   build-essential cmake pkg-config
   libeigen3-dev libceres-dev libsuitesparse-dev libgoogle-glog-dev libyaml-cpp-dev
   libgeographiclib-dev libcli11-dev nlohmann-json3-dev zlib1g-dev

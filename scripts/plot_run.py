@@ -28,7 +28,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
-from gins_geo import lla_to_enu as to_enu, open_text, rot_enu_from_ecef as r_enu_ecef  # noqa: E402
+from gins_geo import lla_to_enu as to_enu, open_text, output_origin, rot_enu_from_ecef as r_enu_ecef  # noqa: E402
 
 STYLE = {  # name: (label, colour); --mode all writes the four
     "eskf": ("ESKF", "tab:blue"),
@@ -49,14 +49,11 @@ def quat_rot(q):  # w, x, y, z -> R
 
 
 def read_states(path):
-    """A *_states.csv: dict of columns, plus the origin from its comment line."""
-    origin = None
+    """A *_states.csv: dict of columns, plus the origin from the TUM file beside it."""
     with open_text(path) as f:
-        first = f.readline()
         header = f.readline().strip().split(",")
         data = np.loadtxt(f, delimiter=",", ndmin=2)
-    if "origin_lla=" in first:
-        origin = [float(v) for v in first.split("origin_lla=")[1].split()[:3]]
+    origin, _ = output_origin(path)
     cols = {h: data[:, i] for i, h in enumerate(header)}
     cols["origin"] = origin
     return cols

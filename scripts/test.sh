@@ -3,6 +3,6 @@
 # CI (.ci/run) runs this, then scripts/test_sanitizers.sh (the same suite under ASan + UBSan).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/install_deps.sh
+./scripts/install_deps.sh --test
 ./scripts/build.sh
 (cd build && ctest --output-on-failure -j"$(nproc)")

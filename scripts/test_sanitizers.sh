@@ -4,7 +4,7 @@
 # through the shorter drives). Any sanitizer report fails the run. CI runs it after scripts/test.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/install_deps.sh
+./scripts/install_deps.sh --test
 # -O1 -g1 and no NDEBUG: faster to compile than -O2 -g, line numbers in reports, Eigen and glog checks on.
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DGINS_SANITIZE=ON >/dev/null
 cmake --build build-asan -j"$(nproc)"

@@ -58,6 +58,31 @@ std::optional<GeodeticPoint> HeaderOrigin(const std::string& line) {
   return g;
 }
 
+// The origin comment of a state CSV's TUM file beside it ("x_states.csv[.gz]" -> "x.tum[.gz]"): our CSVs
+// start with their column names, and the run's frame is written once, in the TUM file (docs/formats.md §5.3).
+std::optional<GeodeticPoint> SiblingTumOrigin(const std::string& csv_path, std::string* mode) {
+  static const std::string kSuffix = "_states.csv";
+  const bool gz = csv_path.size() > 3 && csv_path.compare(csv_path.size() - 3, 3, ".gz") == 0;
+  const std::string plain = gz ? csv_path.substr(0, csv_path.size() - 3) : csv_path;
+  if (plain.size() <= kSuffix.size() || plain.compare(plain.size() - kSuffix.size(), kSuffix.size(), kSuffix) != 0) {
+    return std::nullopt;
+  }
+  const std::string stem = plain.substr(0, plain.size() - kSuffix.size());
+  for (const std::string& tum : {stem + ".tum" + (gz ? ".gz" : ""), stem + ".tum"}) {
+    gzFile f = gzopen(tum.c_str(), "rb");
+    if (f == nullptr) continue;
+    char buf[512];
+    const bool read = gzgets(f, buf, sizeof(buf)) != nullptr;
+    gzclose(f);
+    if (!read || buf[0] != '#') continue;
+    if (auto origin = HeaderOrigin(buf)) {
+      *mode = HeaderValue(buf, "mode");
+      return origin;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 void TrajectoryReader::GzClose::operator()(gzFile_s* f) const { gzclose(f); }
@@ -66,6 +91,7 @@ TrajectoryReader::TrajectoryReader(const std::string& path) : path_(path), file_
   if (file_ == nullptr) throw InputError(path + ": cannot open trajectory file");
   has_pending_ = ReadRow(&pending_);
   if (!has_pending_) throw InputError(path + ": no trajectory rows");
+  if (!origin_ && header_seen_) origin_ = SiblingTumOrigin(path, &mode_);
 }
 
 TrajectoryReader::~TrajectoryReader() = default;
@@ -142,6 +168,12 @@ bool TrajectoryReader::ReadRow(TrajectorySample* sample) {
         has_velocity_ = true;
       }
       if (index.count("sigma_att_u")) col_.sigma_att_u = index["sigma_att_u"];
+      if (index.count("sigma_px") && index.count("sigma_py") && index.count("sigma_pz")) {
+        col_.sigma_px = index["sigma_px"];
+        col_.sigma_py = index["sigma_py"];
+        col_.sigma_pz = index["sigma_pz"];
+        has_sigma_ = true;
+      }
       col_.count = fields_.size();
       header_seen_ = true;
       continue;
@@ -161,6 +193,7 @@ bool TrajectoryReader::ReadRow(TrajectorySample* sample) {
     if (q.norm() < 0.5 || q.norm() > 2.0) Fail("quaternion is not a rotation (norm " + std::to_string(q.norm()) + ")");
     s.q_wb = q.normalized();
     if (has_velocity_) s.v_w = Vec3(v[col_.vx], v[col_.vy], v[col_.vz]);
+    if (has_sigma_) s.sigma_p = Vec3(v[col_.sigma_px], v[col_.sigma_py], v[col_.sigma_pz]);
     if (col_.sigma_att_u >= 0) s.yaw_known = v[col_.sigma_att_u] < kUnknownYawSigmaBound;
     *sample = s;
     row_seen_ = true;
@@ -178,6 +211,7 @@ Trajectory ReadTrajectory(const std::string& path) {
   traj.mode = reader.mode();
   traj.origin = reader.origin();
   traj.has_velocity = reader.has_velocity();
+  traj.has_sigma = reader.has_sigma();
   return traj;
 }
 

@@ -20,6 +20,7 @@ struct TrajectorySample {
   Vec3 p_w = Vec3::Zero();
   Quat q_wb = Quat::Identity();
   Vec3 v_w = Vec3::Zero();
+  Vec3 sigma_p = Vec3::Zero();  // m, E N U: a state CSV's sigma_px.. columns (Trajectory::has_sigma)
   // False when a state CSV's sigma_att_u says the estimate has no yaw there (kUnknownYawSigma).
   bool yaw_known = true;
 };
@@ -29,13 +30,15 @@ struct Trajectory {
   std::string mode;                     // from the "# gins mode=..." header; empty for foreign files
   std::optional<GeodeticPoint> origin;  // from "origin_lla=lat lon alt"; absent for foreign files
   bool has_velocity = false;            // a state CSV (vx, vy, vz columns)
+  bool has_sigma = false;               // a state CSV (sigma_px, sigma_py, sigma_pz columns)
   std::vector<TrajectorySample> samples;  // strictly increasing time
 };
 
 // Reads `t x y z qx qy qz qw` (TUM, whitespace separated) or a CSV with a header naming at least
 // t,px,py,pz,qw,qx,qy,qz (our *_states.csv; vx,vy,vz give the velocity) row by row: memory holds two rows,
 // not the file, so an IMU-rate output of any length reads in constant memory. `#` lines are comments; the
-// first one carrying `origin_lla=` gives the origin and `mode=` the name. Rows with the time of the previous
+// first one carrying `origin_lla=` gives the origin and `mode=` the name; a state CSV without it (ours start
+// with the column names) takes them from the TUM file beside it (x_states.csv -> x.tum), if there is one. Rows with the time of the previous
 // row replace it (the later state is the newer estimate), so a sample is handed out once the next time is
 // read. Throws InputError naming file and line for unreadable files, malformed or non-finite rows, time
 // going backwards, or no rows at all; the constructor already for the first row or an empty file.
@@ -56,6 +59,7 @@ class TrajectoryReader {
   const std::string& mode() const { return mode_; }
   const std::optional<GeodeticPoint>& origin() const { return origin_; }
   bool has_velocity() const { return has_velocity_; }
+  bool has_sigma() const { return has_sigma_; }
 
  private:
   // The next row as read (a repeated time not yet merged); false at the end of the file.
@@ -64,7 +68,7 @@ class TrajectoryReader {
 
   std::string path_, mode_;
   std::optional<GeodeticPoint> origin_;
-  bool has_velocity_ = false;
+  bool has_velocity_ = false, has_sigma_ = false;
   struct GzClose {
     void operator()(gzFile_s* f) const;
   };
@@ -75,6 +79,7 @@ class TrajectoryReader {
     int t = 0, px = 1, py = 2, pz = 3, qx = 4, qy = 5, qz = 6, qw = 7;
     int vx = -1, vy = -1, vz = -1;
     int sigma_att_u = -1;
+    int sigma_px = -1, sigma_py = -1, sigma_pz = -1;
     size_t count = 8;
   } col_;
   std::string line_;                               // reused: no allocation per row

@@ -43,6 +43,7 @@ class Line {
     return *this;
   }
   void WriteTo(FILE* f) { std::fwrite(buf_, 1, static_cast<size_t>(pos_ - buf_), f); }
+  const char* pos() const { return pos_; }
 
  private:
   char buf_[kMaxFields * (kMaxField + 1)];
@@ -135,20 +136,56 @@ bool StatesFinite(const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3&
   return x.AllFinite() && sp.allFinite() && sv.allFinite() && sa.allFinite() && std::isfinite(odom_scale);
 }
 
+// The [begin, end) of the position σ fields in a states line, for the geodetic line to copy.
+struct SigmaFields {
+  const char* begin[3];
+  const char* end[3];
+};
+
 void WriteStatesCsv(FILE* f, const PoseFields& pose, const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa,
-                    double odom_scale) {
+                    double odom_scale, Line* l, SigmaFields* sigma) {
+  l->Text(pose.begin(PoseFields::kT), pose.end(PoseFields::kT));
+  for (int i = 0; i < 3; ++i) l->Char(',').Text(pose.begin(PoseFields::kP + i), pose.end(PoseFields::kP + i));
+  for (int i = 0; i < 3; ++i) l->Char(',').Fixed(x.v_w[i], 5);
+  // q as w, x, y, z here.
+  l->Char(',').Text(pose.begin(PoseFields::kQ + 3), pose.end(PoseFields::kQ + 3));
+  for (int i = 0; i < 3; ++i) l->Char(',').Text(pose.begin(PoseFields::kQ + i), pose.end(PoseFields::kQ + i));
+  for (const Vec3* v : {&x.bg, &x.ba}) {
+    for (int i = 0; i < 3; ++i) l->Char(',').Sci((*v)[i], 4);
+  }
+  for (int i = 0; i < 3; ++i) {
+    l->Char(',');
+    sigma->begin[i] = l->pos();
+    l->Sci(sp[i], 4);
+    sigma->end[i] = l->pos();
+  }
+  for (const Vec3* v : {&sv, &sa}) {
+    for (int i = 0; i < 3; ++i) l->Char(',').Sci((*v)[i], 4);
+  }
+  l->Char(',').Fixed(odom_scale, 6).Char('\n');
+  l->WriteTo(f);
+}
+
+// The geodetic line from the fields already formatted: the time and, when a states line was written, its
+// position σ (the same formatting: WriteGeodeticCsvLine's bytes).
+bool WriteGeodetic(FILE* f, const LocalEnuFrame& frame, const PoseFields& pose, const Vec3& p_w, const Vec3& sp,
+                   const SigmaFields* sigma) {
+  const GeodeticPoint g = frame.ToGeodetic(p_w);
+  if (!std::isfinite(g.lat_deg) || !std::isfinite(g.lon_deg) || !std::isfinite(g.alt_m)) return false;
+  // 9 decimals of a degree: 0.1 mm, below the TUM file's 5 decimals of a metre.
   Line l;
   l.Text(pose.begin(PoseFields::kT), pose.end(PoseFields::kT));
-  for (int i = 0; i < 3; ++i) l.Char(',').Text(pose.begin(PoseFields::kP + i), pose.end(PoseFields::kP + i));
-  for (int i = 0; i < 3; ++i) l.Char(',').Fixed(x.v_w[i], 5);
-  // q as w, x, y, z here.
-  l.Char(',').Text(pose.begin(PoseFields::kQ + 3), pose.end(PoseFields::kQ + 3));
-  for (int i = 0; i < 3; ++i) l.Char(',').Text(pose.begin(PoseFields::kQ + i), pose.end(PoseFields::kQ + i));
-  for (const Vec3* v : {&x.bg, &x.ba, &sp, &sv, &sa}) {
-    for (int i = 0; i < 3; ++i) l.Char(',').Sci((*v)[i], 4);
+  l.Char(',').Fixed(g.lat_deg, 9).Char(',').Fixed(g.lon_deg, 9).Char(',').Fixed(g.alt_m, 4);
+  for (int i = 0; i < 3; ++i) {
+    l.Char(',');
+    if (sigma != nullptr) {
+      l.Text(sigma->begin[i], sigma->end[i]);
+    } else {
+      l.Sci(sp[i], 4);
+    }
   }
-  l.Char(',').Fixed(odom_scale, 6).Char('\n');
-  l.WriteTo(f);
+  l.Char('\n').WriteTo(f);
+  return true;
 }
 
 }  // namespace
@@ -165,10 +202,18 @@ bool TumWriter::Add(const NavState& x) {
   return true;
 }
 
-StatesCsvWriter::StatesCsvWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin)
-    : file_(path) {
-  file_.Write(TrajectoryHeader(mode, origin));
-  file_.Write(kStatesCsvColumns);
+StatesCsvWriter::StatesCsvWriter(const std::string& path) : file_(path) { file_.Write(kStatesCsvColumns); }
+
+const char kGeodeticCsvColumns[] = "t,lat_deg,lon_deg,height_m,sigma_e_m,sigma_n_m,sigma_u_m\n";
+
+bool WriteGeodeticCsvLine(FILE* f, const LocalEnuFrame& frame, const NavState& x, const Vec3& sp) {
+  if (!x.AllFinite() || !sp.allFinite()) return false;
+  return WriteGeodetic(f, frame, PoseFields(x), x.p_wb, sp, nullptr);
+}
+
+GeodeticCsvWriter::GeodeticCsvWriter(const std::string& path, const LocalEnuFrame& frame)
+    : file_(path), frame_(frame) {
+  file_.Write(kGeodeticCsvColumns);
 }
 
 bool StatesCsvWriter::Add(const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa, double odom_scale) {
@@ -178,17 +223,25 @@ bool StatesCsvWriter::Add(const NavState& x, const Vec3& sp, const Vec3& sv, con
 bool WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sp, const Vec3& sv, const Vec3& sa,
                         double odom_scale) {
   if (!StatesFinite(x, sp, sv, sa, odom_scale)) return false;
-  WriteStatesCsv(f, PoseFields(x), x, sp, sv, sa, odom_scale);
+  Line l;
+  SigmaFields sigma;
+  WriteStatesCsv(f, PoseFields(x), x, sp, sv, sa, odom_scale, &l, &sigma);
   return true;
 }
 
-bool TumWriter::AddWithStates(StatesCsvWriter* states, const NavState& x, const Vec3& sp, const Vec3& sv,
-                              const Vec3& sa, double odom_scale) {
+bool TumWriter::AddWithStates(StatesCsvWriter* states, GeodeticCsvWriter* geodetic, const NavState& x,
+                              const Vec3& sp, const Vec3& sv, const Vec3& sa, double odom_scale) {
   if (!x.AllFinite()) return false;
   const PoseFields pose(x);
   WriteTum(file_.stream(), pose);
   ++count_;
-  if (StatesFinite(x, sp, sv, sa, odom_scale)) WriteStatesCsv(states->stream(), pose, x, sp, sv, sa, odom_scale);
+  Line l;
+  SigmaFields sigma;
+  const bool states_written = states != nullptr && StatesFinite(x, sp, sv, sa, odom_scale);
+  if (states_written) WriteStatesCsv(states->stream(), pose, x, sp, sv, sa, odom_scale, &l, &sigma);
+  if (geodetic != nullptr && sp.allFinite()) {
+    WriteGeodetic(geodetic->stream(), geodetic->frame(), pose, x.p_wb, sp, states_written ? &sigma : nullptr);
+  }
   return true;
 }
 

@@ -32,7 +32,7 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-// Comment line naming the mode and the world frame's origin (docs/formats.md §5.2).
+// The TUM file's comment line naming the mode and the world frame's origin (docs/formats.md §5.2).
 std::string TrajectoryHeader(const std::string& mode, const GeodeticPoint& origin);
 
 // One line of each format (with its '\n') to any stream: the writers below and `gins stream`'s stdout
@@ -42,20 +42,25 @@ std::string TrajectoryHeader(const std::string& mode, const GeodeticPoint& origi
 bool WriteTumLine(FILE* f, const NavState& x);
 bool WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att,
                         double odom_scale);
-// The states CSV's column header line (after the TrajectoryHeader comment).
+// The states CSV's first line: its column names (the origin is in the TUM file beside it, §5.3).
 extern const char kStatesCsvColumns[];
+// The geodetic track: one line of "t,lat_deg,lon_deg,height_m,sigma_e_m,sigma_n_m,sigma_u_m" (§5.4), and
+// its first line.
+bool WriteGeodeticCsvLine(FILE* f, const LocalEnuFrame& frame, const NavState& x, const Vec3& sigma_p);
+extern const char kGeodeticCsvColumns[];
 
 class StatesCsvWriter;
+class GeodeticCsvWriter;
 
 // TUM trajectory: "t x y z qx qy qz qw" (body in w).
 class TumWriter {
  public:
   TumWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin);
   bool Add(const NavState& x);
-  // Add(x) and states->Add(x, ...) in one, formatting the fields the two lines share (t, p, q) once: the
-  // same bytes as the two calls.
-  bool AddWithStates(StatesCsvWriter* states, const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v,
-                     const Vec3& sigma_att, double odom_scale);
+  // Add(x), states->Add(x, ...) and geodetic->Add(x, sigma_p) in one (either may be null), formatting the
+  // fields the lines share (t, p, q, the position σ) once: the same bytes as the separate calls.
+  bool AddWithStates(StatesCsvWriter* states, GeodeticCsvWriter* geodetic, const NavState& x, const Vec3& sigma_p,
+                     const Vec3& sigma_v, const Vec3& sigma_att, double odom_scale);
   void Commit() { file_.Commit(); }
   uint64_t count() const { return count_; }
 
@@ -67,13 +72,27 @@ class TumWriter {
 // Full state CSV with 1-σ columns.
 class StatesCsvWriter {
  public:
-  StatesCsvWriter(const std::string& path, const std::string& mode, const GeodeticPoint& origin);
+  explicit StatesCsvWriter(const std::string& path);
   bool Add(const NavState& x, const Vec3& sigma_p, const Vec3& sigma_v, const Vec3& sigma_att, double odom_scale);
   void Commit() { file_.Commit(); }
   FILE* stream() { return file_.stream(); }
 
  private:
   AtomicFile file_;
+};
+
+// The geodetic track of a stream: WGS84 latitude, longitude and ellipsoidal height with the position's 1-σ.
+class GeodeticCsvWriter {
+ public:
+  GeodeticCsvWriter(const std::string& path, const LocalEnuFrame& frame);
+  bool Add(const NavState& x, const Vec3& sigma_p) { return WriteGeodeticCsvLine(file_.stream(), frame_, x, sigma_p); }
+  void Commit() { file_.Commit(); }
+  FILE* stream() { return file_.stream(); }
+  const LocalEnuFrame& frame() const { return frame_; }
+
+ private:
+  AtomicFile file_;
+  LocalEnuFrame frame_;
 };
 
 }  // namespace gins

@@ -193,16 +193,18 @@ TEST_F(CliRun, RunEskfWithTruth) {
   const std::string out = dir_ + "/out_eskf";
   ASSERT_EQ(
       RunCliInChild({"run", "--config", config_, "--log", log_, "--out", out, "--mode", "eskf", "--truth", truth_}), 0);
-  EXPECT_EQ(FilesIn(out), 3u);  // eskf.tum, eskf_states.csv, summary.json
+  EXPECT_EQ(FilesIn(out), 4u);  // eskf.tum, eskf_states.csv, eskf_lla.csv, summary.json
   const std::vector<std::string> tum = Lines(test::ReadFile(out + "/eskf.tum"));
   ASSERT_GE(tum.size(), 2u);
   EXPECT_EQ(tum[0].rfind("# gins mode=eskf", 0), 0u) << tum[0];
   EXPECT_NE(tum[0].find("origin_lla="), std::string::npos) << tum[0];
   const std::vector<std::string> states = Lines(test::ReadFile(out + "/eskf_states.csv"));
-  ASSERT_GE(states.size(), 3u);
-  EXPECT_EQ(states[0].rfind("# gins mode=eskf", 0), 0u) << states[0];
-  EXPECT_EQ(states[1].rfind("t,px,py,pz,vx,vy,vz,qw,qx,qy,qz,", 0), 0u) << states[1];
-  EXPECT_EQ(states.size() - 2, tum.size() - 1);  // one row per state in both
+  ASSERT_GE(states.size(), 2u);
+  EXPECT_EQ(states[0].rfind("t,px,py,pz,vx,vy,vz,qw,qx,qy,qz,", 0), 0u) << states[0];  // the names first
+  EXPECT_EQ(states.size() - 1, tum.size() - 1);  // one row per state in both
+  const std::vector<std::string> lla = Lines(test::ReadFile(out + "/eskf_lla.csv"));
+  EXPECT_EQ(lla[0], "t,lat_deg,lon_deg,height_m,sigma_e_m,sigma_n_m,sigma_u_m");
+  EXPECT_EQ(lla.size(), states.size());
 
   const nlohmann::json s = Summary(out);
   const std::string log = test::ReadFile(log_);
@@ -235,7 +237,7 @@ TEST_F(CliRun, RunSmoother) {
   EXPECT_TRUE(fs::exists(out + "/smoother_states.csv"));
   EXPECT_TRUE(fs::exists(out + "/smoother_online.tum"));
   EXPECT_FALSE(fs::exists(out + "/eskf.tum"));
-  EXPECT_EQ(FilesIn(out), 4u);
+  EXPECT_EQ(FilesIn(out), 6u);  // and smoother_lla.csv, smoother_online_lla.csv, summary.json
   const std::vector<std::string> tum = Lines(test::ReadFile(out + "/smoother.tum"));
   ASSERT_GE(tum.size(), 2u);
   EXPECT_EQ(tum[0].rfind("# gins mode=smoother ", 0), 0u) << tum[0];
@@ -264,9 +266,10 @@ TEST_F(CliRun, AReusedOutFolderHoldsTheNewestRunAloneWithAbsolutePaths) {
   for (const char* stale : {"smoother", "smoother_online", "batch", "eskf_rts"}) {
     EXPECT_FALSE(fs::exists(out + "/" + stale + ".tum")) << stale;
     EXPECT_FALSE(fs::exists(out + "/" + stale + "_states.csv")) << stale;
+    EXPECT_FALSE(fs::exists(out + "/" + stale + "_lla.csv")) << stale;
   }
   EXPECT_TRUE(fs::exists(out + "/eskf.tum"));
-  EXPECT_EQ(FilesIn(out), 3u);  // eskf.tum, eskf_states.csv, summary.json
+  EXPECT_EQ(FilesIn(out), 4u);  // eskf.tum, eskf_states.csv, eskf_lla.csv, summary.json
   const nlohmann::json s = Summary(out);
   EXPECT_EQ(s["log"].get<std::string>(), fs::absolute(log_).lexically_normal().string());
   EXPECT_EQ(s["truth"].get<std::string>(), fs::absolute(truth_).lexically_normal().string());
@@ -313,10 +316,11 @@ TEST_F(CliRun, RunBoth) {
   ASSERT_EQ(
       RunCliInChild({"run", "--config", config_, "--log", log_, "--out", out, "--mode", "both", "--truth", truth_}), 0);
   for (const char* f :
-       {"eskf.tum", "eskf_states.csv", "smoother.tum", "smoother_states.csv", "smoother_online.tum", "summary.json"}) {
+       {"eskf.tum", "eskf_states.csv", "eskf_lla.csv", "smoother.tum", "smoother_states.csv", "smoother_lla.csv",
+        "smoother_online.tum", "smoother_online_lla.csv", "summary.json"}) {
     EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
   }
-  EXPECT_EQ(FilesIn(out), 6u);
+  EXPECT_EQ(FilesIn(out), 9u);
   const std::vector<std::string> online = Lines(test::ReadFile(out + "/smoother_online.tum"));
   ASSERT_GE(online.size(), 2u);
   EXPECT_EQ(online[0].rfind("# gins mode=smoother_online ", 0), 0u) << online[0];

@@ -161,6 +161,8 @@ TEST(StreamCliTest, EqualsRunInBothModesAndFormats) {
       {{"--mode", "smoother"}, "smoother.tum"},
       {{"--mode", "smoother", "--out-format", "csv"}, "smoother_states.csv"},
       {{"--mode", "smoother", "--online"}, "smoother_online.tum"},
+      {{"--mode", "eskf", "--out-format", "lla"}, "eskf_lla.csv"},
+      {{"--mode", "smoother", "--out-format", "lla"}, "smoother_lla.csv"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args = {"stream", "--config", kConfig};

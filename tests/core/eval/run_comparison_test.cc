@@ -59,9 +59,9 @@ RunDir WriteRunDirectory(const std::string& name) {
   const Vec3 sigma = Vec3::Constant(0.1);
   {
     TumWriter eskf_tum(run.dir + "/eskf.tum", "eskf", kOrigin);
-    StatesCsvWriter eskf(run.dir + "/eskf_states.csv", "eskf", kOrigin);
+    StatesCsvWriter eskf(run.dir + "/eskf_states.csv");
     TumWriter smoother_tum(run.dir + "/smoother.tum", "smoother", kOrigin);
-    StatesCsvWriter smoother(run.dir + "/smoother_states.csv", "smoother", kOrigin);
+    StatesCsvWriter smoother(run.dir + "/smoother_states.csv");
     TumWriter online(run.dir + "/smoother_online.tum", "smoother_online", kOrigin);
     for (int k = 200; k <= 29800; ++k) {
       const double s = 0.01 * k;

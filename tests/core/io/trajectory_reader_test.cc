@@ -35,7 +35,7 @@ TEST(ReadTrajectory, ReadsWhatTheWritersWrite) {
   const std::string dir = test::MakeTempDir("traj_reader");
   {
     TumWriter tum(dir + "/eskf.tum", "eskf", kOrigin);
-    StatesCsvWriter csv(dir + "/eskf_states.csv", "eskf", kOrigin);
+    StatesCsvWriter csv(dir + "/eskf_states.csv");
     for (const NavState& x : States()) {
       tum.Add(x);
       csv.Add(x, Vec3::Constant(0.1), Vec3::Constant(0.2), Vec3::Constant(0.3), 1.0);
@@ -60,18 +60,41 @@ TEST(ReadTrajectory, ReadsWhatTheWritersWrite) {
     }
     const bool csv = std::string(file).find(".csv") != std::string::npos;
     EXPECT_EQ(t.has_velocity, csv);
+    EXPECT_EQ(t.has_sigma, csv);
     if (csv) {
       EXPECT_LT((t.samples[2].v_w - states[2].v_w).norm(), 1e-5);
+      EXPECT_NEAR(t.samples[2].sigma_p.y(), 0.1, 1e-9);
     }
     for (const TrajectorySample& s : t.samples) EXPECT_TRUE(s.yaw_known);
   }
+}
+
+// A state CSV starts with its column names: its origin is the TUM file's beside it; alone it has none (and
+// is read as a foreign trajectory, in the evaluation's frame).
+TEST(ReadTrajectory, AStatesCsvTakesItsOriginFromItsTumFile) {
+  const std::string dir = test::MakeTempDir("traj_reader_sibling");
+  {
+    StatesCsvWriter csv(dir + "/batch_states.csv");
+    for (const NavState& x : States()) csv.Add(x, Vec3::Constant(0.1), Vec3::Constant(0.2), Vec3::Constant(0.3), 1.0);
+    csv.Commit();
+  }
+  EXPECT_FALSE(ReadTrajectory(dir + "/batch_states.csv").origin.has_value());
+  {
+    TumWriter tum(dir + "/batch.tum", "batch", kOrigin);
+    tum.Add(States()[0]);
+    tum.Commit();
+  }
+  const Trajectory t = ReadTrajectory(dir + "/batch_states.csv");
+  ASSERT_TRUE(t.origin.has_value());
+  EXPECT_NEAR(t.origin->lat_deg, kOrigin.lat_deg, 1e-10);
+  EXPECT_EQ(t.mode, "batch");
 }
 
 // A state CSV's yaw σ of an unknown angle (a state at rest before the initialisation) reads as no yaw.
 TEST(ReadTrajectory, AnUnknownYawSigmaReadsAsNoYaw) {
   const std::string dir = test::MakeTempDir("traj_reader_yaw");
   {
-    StatesCsvWriter csv(dir + "/eskf_states.csv", "eskf", kOrigin);
+    StatesCsvWriter csv(dir + "/eskf_states.csv");
     const auto states = States();
     csv.Add(states[0], Vec3::Constant(0.1), Vec3::Constant(0.2), Vec3(0.01, 0.01, kUnknownYawSigma), 1.0);
     csv.Add(states[1], Vec3::Constant(0.1), Vec3::Constant(0.2), Vec3(0.01, 0.01, 0.2), 1.0);
@@ -137,7 +160,7 @@ TEST(ReadTrajectory, MalformedFilesNameFileAndLine) {
 TEST(TrajectoryReader, StreamsWhatReadTrajectoryReads) {
   const std::string dir = test::MakeTempDir("traj_stream");
   {
-    StatesCsvWriter csv(dir + "/eskf_states.csv", "eskf", kOrigin);
+    StatesCsvWriter csv(dir + "/eskf_states.csv");
     for (const NavState& x : States()) csv.Add(x, Vec3::Constant(0.1), Vec3::Constant(0.2), Vec3::Constant(0.3), 1.0);
     csv.Commit();
   }

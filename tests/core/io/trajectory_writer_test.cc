@@ -171,20 +171,20 @@ TEST(TumWriter, UncommittedLeavesNothing) {
   EXPECT_TRUE(DirEntries(dir).empty());
 }
 
-TEST(StatesCsvWriter, HeaderAndRowRoundTrip) {
+// The column names are the first line (pandas.read_csv opens it as it is); the origin is the TUM file's.
+TEST(StatesCsvWriter, ColumnNamesFirstThenRows) {
   const std::string dir = test::MakeTempDir("states_csv");
   const std::string path = dir + "/smoother_states.csv";
   const NavState x = SampleState();
   const Vec3 sp(0.011, 0.012, 0.013), sv(0.0021, 0.0022, 0.0023), sa(1.5e-4, 2.5e-4, 3.5e-3);
   const double scale = 0.990123;
   {
-    StatesCsvWriter w(path, "smoother", kOrigin);
+    StatesCsvWriter w(path);
     w.Add(x, sp, sv, sa, scale);
     w.Commit();
   }
   const std::vector<std::string> lines = Lines(test::ReadFile(path));
-  ASSERT_EQ(lines.size(), 3u);
-  EXPECT_EQ(lines[0] + "\n", TrajectoryHeader("smoother", kOrigin));
+  ASSERT_EQ(lines.size(), 2u);
   const std::vector<std::string> expected_columns = {
       "t",        "px",       "py",          "pz",          "vx",          "vy",        "vz",
       "qw",       "qx",       "qy",          "qz",          "bgx",         "bgy",       "bgz",
@@ -192,13 +192,13 @@ TEST(StatesCsvWriter, HeaderAndRowRoundTrip) {
       "sigma_vy", "sigma_vz", "sigma_att_e", "sigma_att_n", "sigma_att_u", "odom_scale"};
   std::vector<std::string> columns;
   {
-    std::istringstream in(lines[1]);
+    std::istringstream in(lines[0]);
     std::string c;
     while (std::getline(in, c, ',')) columns.push_back(c);
   }
   EXPECT_EQ(columns, expected_columns);
 
-  const std::vector<double> v = Numbers(lines[2], ',');
+  const std::vector<double> v = Numbers(lines[1], ',');
   ASSERT_EQ(v.size(), expected_columns.size());
   EXPECT_NEAR(v[0], x.t, 1e-6);
   for (int i = 0; i < 3; ++i) {
@@ -231,7 +231,7 @@ TEST(StatesCsvWriter, RefusesNonFiniteStatesAndWritesHugeOnesWhole) {
   huge.p_wb = Vec3::Constant(-1e300);
   huge.v_w = Vec3::Constant(1e300);
   {
-    StatesCsvWriter w(csv, "eskf", kOrigin);
+    StatesCsvWriter w(csv);
     TumWriter t(tum, "eskf", kOrigin);
     NavState bad = x;
     bad.v_w.y() = nan;
@@ -250,7 +250,7 @@ TEST(StatesCsvWriter, RefusesNonFiniteStatesAndWritesHugeOnesWhole) {
   }
   for (const auto& [path, sep, columns] : {std::tuple{csv, ',', 27u}, std::tuple{tum, ' ', 8u}}) {
     const std::vector<std::string> lines = Lines(test::ReadFile(path));
-    ASSERT_EQ(lines.size(), path == csv ? 4u : 3u) << path;
+    ASSERT_EQ(lines.size(), 3u) << path;  // the columns or the comment, then two rows
     for (size_t i = lines.size() - 2; i < lines.size(); ++i) {
       EXPECT_EQ(lines[i].find("nan"), std::string::npos) << lines[i];
       EXPECT_EQ(lines[i].find("inf"), std::string::npos) << lines[i];
@@ -262,36 +262,82 @@ TEST(StatesCsvWriter, RefusesNonFiniteStatesAndWritesHugeOnesWhole) {
   }
 }
 
-// TumWriter::AddWithStates writes the bytes Add and StatesCsvWriter::Add write, huge values included; a state
-// with a non-finite σ still gets its TUM line (the TUM has no σ) but no CSV line, as with the two calls.
-TEST(TumWriter, AddWithStatesWritesWhatTheTwoWritersWrite) {
+// TumWriter::AddWithStates writes the bytes Add, StatesCsvWriter::Add and GeodeticCsvWriter::Add write, huge
+// values included; a state with a non-finite σ still gets its TUM line (the TUM has no σ) but no CSV line
+// (a non-finite velocity σ: no states line, a geodetic one), as with the separate calls.
+TEST(TumWriter, AddWithStatesWritesWhatTheSeparateWritersWrite) {
   const std::string dir = test::MakeTempDir("tum_with_states");
   NavState huge = SampleState();
   huge.t += 1.0;
   huge.p_wb = Vec3(-1e300, 2.5e17, -0.0);
   huge.q_wb = Quat(0.5, -0.5, 0.5, -0.5);
+  NavState later = SampleState();
+  later.t += 2.0;
+  later.p_wb = Vec3(-3.25, 1234.5, 7.0);
   const Vec3 s(0.1, 2e-7, 3e4);
   const Vec3 nan_sigma(0.1, std::nan(""), 0.1);
+  const LocalEnuFrame frame(kOrigin);
+  struct Row {
+    NavState x;
+    Vec3 sigma_p, sigma_v;
+  };
+  const Row rows[] = {{SampleState(), s, s}, {huge, s, s}, {SampleState(), nan_sigma, s}, {later, s, nan_sigma}};
   for (const char* variant : {"pair", "one"}) {
     const std::string base = dir + "/" + variant;
     TumWriter t(base + ".tum", "eskf", kOrigin);
-    StatesCsvWriter w(base + "_states.csv", "eskf", kOrigin);
-    const std::pair<NavState, Vec3> rows[] = {{SampleState(), s}, {huge, s}, {SampleState(), nan_sigma}};
-    for (const auto& [x, sigma] : rows) {
+    StatesCsvWriter w(base + "_states.csv");
+    GeodeticCsvWriter g(base + "_lla.csv", frame);
+    for (const Row& r : rows) {
       if (std::string(variant) == "pair") {
-        t.Add(x);
-        w.Add(x, sigma, s, s, 0.99);
+        t.Add(r.x);
+        w.Add(r.x, r.sigma_p, r.sigma_v, s, 0.99);
+        g.Add(r.x, r.sigma_p);
       } else {
-        EXPECT_TRUE(t.AddWithStates(&w, x, sigma, s, s, 0.99));
+        EXPECT_TRUE(t.AddWithStates(&w, &g, r.x, r.sigma_p, r.sigma_v, s, 0.99));
       }
     }
-    EXPECT_EQ(t.count(), 3u);
+    EXPECT_EQ(t.count(), 4u);
     t.Commit();
     w.Commit();
+    g.Commit();
   }
-  EXPECT_EQ(test::ReadFile(dir + "/one.tum"), test::ReadFile(dir + "/pair.tum"));
-  EXPECT_EQ(test::ReadFile(dir + "/one_states.csv"), test::ReadFile(dir + "/pair_states.csv"));
-  EXPECT_EQ(Lines(test::ReadFile(dir + "/one_states.csv")).size(), 4u);  // header, columns, two rows
+  for (const char* file : {".tum", "_states.csv", "_lla.csv"}) {
+    EXPECT_EQ(test::ReadFile(dir + "/one" + file), test::ReadFile(dir + "/pair" + file)) << file;
+  }
+  EXPECT_EQ(Lines(test::ReadFile(dir + "/one_states.csv")).size(), 3u);  // columns, two rows
+  // Columns and all but the third state (no position σ); the huge one far off the Earth, but finite.
+  EXPECT_EQ(Lines(test::ReadFile(dir + "/one_lla.csv")).size(), 4u);
+}
+
+// The geodetic track: column names first, then latitude, longitude and height of the state's position in
+// the frame (to 0.1 mm back through the frame) with its σ; a non-finite state is refused.
+TEST(GeodeticCsvWriter, WritesTheStatesOnTheEarthWithTheirSigma) {
+  const std::string dir = test::MakeTempDir("lla_csv");
+  const std::string path = dir + "/eskf_lla.csv";
+  const LocalEnuFrame frame(kOrigin);
+  NavState x = SampleState();
+  x.p_wb = Vec3(1234.5678, -876.54321, 15.25);
+  const Vec3 sp(0.011, 0.012, 0.031);
+  {
+    GeodeticCsvWriter w(path, frame);
+    EXPECT_TRUE(w.Add(x, sp));
+    NavState bad = x;
+    bad.p_wb.x() = std::nan("");
+    EXPECT_FALSE(w.Add(bad, sp));
+    EXPECT_FALSE(w.Add(x, Vec3(0.1, HUGE_VAL, 0.1)));
+    w.Commit();
+  }
+  const std::vector<std::string> lines = Lines(test::ReadFile(path));
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0] + "\n", kGeodeticCsvColumns);
+  EXPECT_EQ(lines[0], "t,lat_deg,lon_deg,height_m,sigma_e_m,sigma_n_m,sigma_u_m");
+  const std::vector<double> v = Numbers(lines[1], ',');
+  ASSERT_EQ(v.size(), 7u);
+  EXPECT_NEAR(v[0], x.t, 1e-6);
+  const Vec3 back = frame.ToEnu(GeodeticPoint{v[1], v[2], v[3]});
+  EXPECT_LT((back - x.p_wb).norm(), 1e-4);
+  EXPECT_NEAR(v[1], 31.5081830000 - 876.54321 / 110900.0, 1e-3);  // about 111 km per degree of latitude
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(v[4 + i], sp[i], 1e-4 * sp[i]);
 }
 
 }  // namespace

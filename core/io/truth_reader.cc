@@ -38,6 +38,14 @@ bool TruthReader::Next(TruthSample* sample) {
     }
     while (*p == '\r' || *p == '\n' || *p == ' ') ++p;
     if (*p != '\0') throw InputError(path_ + ":" + std::to_string(line_) + ": truth row has more than 11 fields");
+    if (!IsPlausibleGeodetic(v[1], v[2], v[3])) {
+      throw InputError(path_ + ":" + std::to_string(line_) + ": truth row's latitude, longitude or height out of range");
+    }
+    const double q_norm = Quat(v[4], v[5], v[6], v[7]).norm();
+    if (q_norm < 0.5 || q_norm > 2.0) {
+      throw InputError(path_ + ":" + std::to_string(line_) + ": truth row's quaternion is not a rotation (norm " +
+                       std::to_string(q_norm) + ")");
+    }
     if (any_ && v[0] <= last_t_) continue;
     TruthSample s;
     s.t = v[0];

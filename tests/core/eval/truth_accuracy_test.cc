@@ -382,6 +382,20 @@ TEST(TruthReader, DamagedRowNamesFileAndLineWhenReached) {
     EXPECT_NE(std::string(e.what()).find(dir + "/late.csv:4: truth row has more than 11 fields"), std::string::npos)
         << e.what();
   }
+  // Rows that would put NaN into the frame: a latitude beyond the pole, a zero quaternion.
+  for (const auto& [row, why] : {std::pair<std::string, std::string>{"1000.1,91.5,120.4,10,1,0,0,0,0,0,0\n",
+                                                                     "latitude, longitude or height out of range"},
+                                 {"1000.1,31.5,120.4,10,0,0,0,0,0,0,0\n", "quaternion is not a rotation"}}) {
+    test::WriteFile(dir + "/bad.csv", header + "1000.0,31.5,120.4,10,1,0,0,0,0,0,0\n" + row);
+    TruthReader bad(dir + "/bad.csv", LocalEnuFrame(kOrigin));
+    ASSERT_TRUE(bad.Next(&s));
+    try {
+      bad.Next(&s);
+      ADD_FAILURE() << "accepted " << row;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(dir + "/bad.csv:3: truth row's " + why), std::string::npos) << e.what();
+    }
+  }
   test::WriteFile(dir + "/header_only.csv", header);
   TruthReader empty(dir + "/header_only.csv", LocalEnuFrame(kOrigin));
   EXPECT_THROW(empty.Next(&s), InputError);  // no truth rows

@@ -1,5 +1,5 @@
 // `gins report`: many runs side by side, one row per run's summary.json (a fleet of logs run with GNU
-// parallel or a Slurm array, README "Many logs"), as a table on stdout and, with --json, a file.
+// parallel or a Slurm array, docs/fleet.md), as a table on stdout and, with --json, a file.
 #pragma once
 
 #include <string>

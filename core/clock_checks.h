@@ -1,4 +1,4 @@
-// A whole-second offset between the GNSS and the IMU clocks (README "Sanity checks"): leap seconds (GPS
+// A whole-second offset between the GNSS and the IMU clocks (docs/robustness.md): leap seconds (GPS
 // time against UTC: 18 s since 2017), a GPS/TAI mix-up, a logger stamping one stream a second off. For a car
 // (vehicle.nonholonomic: its forward specific force is its speed's rate, on a level road), the IMU's forward
 // specific force and the GNSS track's acceleration, each averaged per second of its own stamps, are

@@ -1,5 +1,5 @@
-// The IMU's units and axes checked from its first samples, before anything is estimated (README "Sanity
-// checks"): a log written in the wrong units or axes must not give a trajectory that looks fine.
+// The IMU's units and axes checked from its first samples, before anything is estimated (docs/robustness.md,
+// "Sanity checks"): a log written in the wrong units or axes must not give a trajectory that looks fine.
 //   |f| far from g (the median over the first kSamples, outside [0.5, 1.5]·g): no vehicle accelerates that
 //       hard for that long. About 1: the accelerometer columns are in g; else another unit or the gyro and
 //       accelerometer columns swapped. Refused: the data cannot be used as they are.
@@ -39,7 +39,7 @@ class ImuAxesAndUnitsCheck {
 
 namespace gins {
 
-// The gyro's turning against the GNSS track's (README "Sanity checks"), for a car (vehicle.nonholonomic: it
+// The gyro's turning against the GNSS track's (docs/robustness.md), for a car (vehicle.nonholonomic: it
 // drives along its body x, so its yaw turns with its course). Over successive fixes the course change Δc
 // (from the track between fixes at least kMinStep and 10 σ apart) is regressed on the gyro's integrated rate
 // about gravity Δg over the same time: Δc = k·Δg. Decided once the vehicle has turned kDecideTurn in all
@@ -91,7 +91,7 @@ class TurnRateCheck {
 
 namespace gins {
 
-// The dual-antenna heading against the GNSS track's course, for a car (README "Sanity checks"; its yaw is
+// The dual-antenna heading against the GNSS track's course, for a car (docs/robustness.md; its yaw is
 // its course, sideslip a few degrees). Over successive fixes with a valid heading at least kMinStep and 10 σ
 // apart (within 5 s), the chord's course is compared with the mean of the two headings less the mount
 // (gnss.mount_yaw_deg): d = heading − mount − course. After kPairs such chords:

@@ -1,7 +1,7 @@
 // Initialisation from any start: the initial navigation state and its covariance, from the first seconds of
 // a log, without being handed anything but the sensors' description.
 //
-// Paths, chosen by what the data shows (README "Initialisation"):
+// Paths, chosen by what the data shows (docs/estimators.md, "Initialisation"):
 //   standstill  the IMU is quiet for init.static_duration_s and a witness agrees that the vehicle stands
 //               (wheels at zero; without encoders the GNSS velocity or the fixes: a quiet IMU alone may be
 //               a cruise, core/standstill_detector.h). Its mean IMU readings give roll, pitch, the gyro bias
@@ -80,7 +80,7 @@ struct InitResult {
   double chi2_per_dof = 0.0, inflation = 1.0, runner_up_delta_chi2 = 0.0;
 };
 
-// Whether an alignment fit may start the estimators (README "Initialisation"): its yaw σ within
+// Whether an alignment fit may start the estimators (docs/estimators.md): its yaw σ within
 // max_attitude_sigma and its roll/pitch σ within max_tilt_sigma, no other yaw explaining the window nearly as
 // well (Δχ² above the χ²(1) 99.99 % quantile times the fit's inflation); or, once the window is as long as it
 // gets (window_full), a settled fit: yaw σ up to 30°, roll/pitch σ up to 5°, the other yaw ruled out at the

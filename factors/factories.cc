@@ -1,7 +1,7 @@
 // The AutoDiffCostFunction instantiations of the small factors, kept in one translation unit so the
 // Jet templates compile once (the IMU factor's lives in imu_factor.cc).
 //
-// The CHECKs below are programmer errors, not data (the audit of README "Faults in the stream"): every σ
+// The CHECKs below are programmer errors, not data (docs/robustness.md, "Faults in the stream"): every σ
 // comes from the config (checked > 0 by config_keys.h) or from a record the reader accepted (σ > 0 and
 // finite, log_limits); a preintegration is attached only when it spans a positive time (Smoother::AnchorAt
 // makes a keyframe instead, and Smoother::IntegrateTo coasts where no sample covers a step); chord and

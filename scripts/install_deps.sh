@@ -18,7 +18,7 @@ packages=("${extra[@]}"
   libgeographiclib-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
   libgtest-dev libgmock-dev
   python3 python3-numpy python3-matplotlib
-  parallel  # the README's fleet recipe, which the tests run
+  parallel  # docs/fleet.md's recipe, which the tests run
 )
 missing=()
 for p in "${packages[@]}"; do

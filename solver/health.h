@@ -1,4 +1,4 @@
-// A health verdict per estimator (README "Health"), from the counts it keeps: ok, degraded or failed, and
+// A health verdict per estimator (docs/robustness.md, "Health"), from its counts: ok, degraded or failed, and
 // why. On the console after a run and in summary.json's "health"; `gins run --strict` exits 3 unless every
 // estimator is ok (fleets: a run that looks like a good one but is not fails its job).
 //   failed    most GNSS fixes rejected (over half of those offered, at least kMinFixes of them): the

@@ -1,5 +1,5 @@
 // What an estimator writes for the time before its initialisation (core/initializer.h), so that every output
-// starts at the first fix (README "Initialisation"):
+// starts at the first fix (docs/estimators.md, "Initialisation"):
 //   forward streams   the states at rest as they come (Initializer::RestStates: the standstill's position, a
 //                     zero velocity, an unknown yaw); then, at the initialisation, the fit's window bridged
 //                     through its IMU samples from the fit's first state to its last (solver/imu_bridge.h),

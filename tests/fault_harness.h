@@ -168,7 +168,7 @@ inline void Displace(const SimOptions& sim, const Vec3& d, GnssRecord* g) {
   g->alt_m = q.alt_m;
 }
 
-// The figures the README's robustness table quotes, in one greppable line per estimator.
+// The figures the fault table of docs/robustness.md quotes, in one greppable line per estimator.
 inline void PrintRecovery(const std::string& fault, const char* estimator, double recovery_s, double max_h_during,
                           double max_h_after) {
   std::printf("[fault] %-44s %-8s recovery %6.2f s, max horizontal error during %8.3f m, after %6.3f m\n",

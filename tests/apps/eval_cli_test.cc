@@ -281,7 +281,7 @@ TEST(EvalRoundTrip, RunWithOutagesThenEval) {
                   1e-4 + 1e-3 * s["accuracy"][name]["rmse_horizontal_m"].get<double>());
     }
     // The first window (before the initialisation, at rest) has the states at rest (the standstill's fixes,
-    // README "Initialisation"); those at 20, 30 and 35 s the estimates.
+    // docs/estimators.md, "Initialisation"); those at 20, 30 and 35 s the estimates.
     EXPECT_GT(t["outages"][0]["samples"].get<int>(), 0);
     EXPECT_LT(t["outages"][0]["max_horizontal_m"].get<double>(), 0.5);
     EXPECT_GE(t["outages_scored"].get<int>(), 3);

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The README's ways to run many logs, run as written on three copies of the sample: the GNU parallel
-# recipe (the block between the README's fleet-recipe markers, executed verbatim) and the Slurm job-array
+# The ways to run many logs of docs/fleet.md, run as written on three copies of the sample: the GNU parallel
+# recipe (the block between that page's fleet-recipe markers, executed verbatim) and the Slurm job-array
 # script (each array task run by hand with its SLURM_ARRAY_TASK_ID); then `gins report` must print one row
 # per run. Usage: fleet_test.sh parallel|slurm BUILD_DIR SOURCE_DIR
 set -euo pipefail
@@ -20,9 +20,9 @@ for n in north south east; do cp "$src/data/sample/log.txt.gz" "logs/drive_$n.tx
 case $what in
   parallel)
     command -v parallel >/dev/null || fail "GNU parallel is not installed (scripts/install_deps.sh installs it)"
-    sed -n '/<!-- fleet-recipe:begin -->/,/<!-- fleet-recipe:end -->/p' "$src/README.md" | sed '/^```/d; /^<!--/d' >recipe.sh
-    [ "$(grep -c 'parallel' recipe.sh)" -ge 1 ] || fail "no parallel recipe between the README's markers"
-    bash -euo pipefail recipe.sh >recipe.out 2>&1 || { cat recipe.out; fail "the README's recipe failed"; }
+    sed -n '/<!-- fleet-recipe:begin -->/,/<!-- fleet-recipe:end -->/p' "$src/docs/fleet.md" | sed '/^```/d; /^<!--/d' >recipe.sh
+    [ "$(grep -c 'parallel' recipe.sh)" -ge 1 ] || fail "no parallel recipe between docs/fleet.md's markers"
+    bash -euo pipefail recipe.sh >recipe.out 2>&1 || { cat recipe.out; fail "docs/fleet.md's recipe failed"; }
     [ "$(grep -c . out/fleet/jobs.tsv)" -eq 4 ] || fail "the joblog does not list three jobs"
     report=recipe.out
     ;;

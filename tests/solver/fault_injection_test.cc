@@ -2,7 +2,7 @@
 // Session as `gins run` feeds them. Each test writes down the expected behaviour and asserts: no abort, every
 // output state finite with σ > 0 (fault_harness.h: ExpectSaneOutputs), and the horizontal error back within a
 // stated bound within a stated time after the fault ends. The measured recoveries print as "[fault] ..."
-// lines (the README's robustness table quotes them).
+// lines (the fault table of docs/robustness.md quotes them).
 //
 // Bounds. The drive's fixes are RTK-like (σ 2 cm horizontal) at 1 Hz, with a dual-antenna heading: a healthy
 // estimate stays within a few centimetres. "Back" is 0.2 m (several times the fix σ, and the error of a

@@ -122,7 +122,7 @@ TEST(InitializationPaths, StaticWithWheelsNoHeading) {
   EXPECT_LT(o.eskf.rmse_yaw_deg, 1.0);
 }
 
-// A start at rest without a heading: every output from the first fix (README "Initialisation"). At rest the
+// A start at rest without a heading: every output from the first fix (docs/estimators.md). At rest the
 // forward streams hold the standstill's position, a zero velocity and an unknown yaw, the two-sided streams
 // the yaw found later (within 4 of their σ); from the standstill's end to the initialisation, the fit's
 // window. Every state before the initialisation lies within 3 of its σ of the truth (95 % of them).

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 
@@ -112,6 +113,19 @@ void PrintRunReport(const RunRequest& req, const RunResult& r) {
   PrintHealth(s);
 }
 
+// --truth auto: NAME.truth.csv.gz or NAME.truth.csv beside the log NAME.txt[.gz] (or NAME[.gz]); "" if none.
+std::string TruthBesideLog(const std::string& log) {
+  std::string stem = log;
+  for (const char* ext : {".gz", ".txt"}) {
+    const size_t n = std::strlen(ext);
+    if (stem.size() > n && stem.compare(stem.size() - n, n, ext) == 0) stem.resize(stem.size() - n);
+  }
+  for (const std::string& truth : {stem + ".truth.csv.gz", stem + ".truth.csv"}) {
+    if (std::filesystem::is_regular_file(truth)) return truth;
+  }
+  return "";
+}
+
 }  // namespace
 
 int RunCli(int argc, const char* const* argv) {
@@ -131,8 +145,10 @@ int RunCli(int argc, const char* const* argv) {
   run->add_option("--log", req.log_path, "Sensor log (plain or .gz)")->required();
   run->add_option("--out", req.out_dir, "Output directory (created if missing)")->required();
   run->add_option("--mode", req.mode, "Estimator")->check(CLI::IsMember(SupportedModes()))->capture_default_str();
-  run->add_option("--truth", truth_path, "Truth CSV (docs/formats.md §4) for an accuracy summary")
-      ->check(CLI::ExistingFile);
+  run->add_option("--truth", truth_path,
+                  "Truth CSV (docs/formats.md §4) for an accuracy summary; auto: the log's own, NAME.truth.csv[.gz] "
+                  "beside NAME.txt[.gz], when there is one (docs/fleet.md)")
+      ->check(CLI::ExistingFile | CLI::IsMember({"auto"}));
   bool strict = false;
   run->add_flag("--strict", strict,
                 "Exit 3 unless every estimator's health verdict is ok (degraded or failed: summary.json's health)");
@@ -176,6 +192,7 @@ int RunCli(int argc, const char* const* argv) {
     if (*run) {
       const api::Config config = api::Config::FromFile(config_path);
       req.config_path = config_path;
+      if (truth_path == "auto") truth_path = TruthBesideLog(req.log_path);
       if (!truth_path.empty()) req.truth_path = truth_path;
       const RunResult result = Run(config, req);
       PrintRunReport(req, result);

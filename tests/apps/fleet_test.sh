@@ -16,6 +16,7 @@ ln -s "$src/config" config
 ln -s "$src/scripts" scripts
 mkdir logs
 for n in north south east; do cp "$src/data/sample/log.txt.gz" "logs/drive_$n.txt.gz"; done
+cp "$src/data/sample/truth.csv.gz" logs/drive_north.truth.csv.gz  # one log brings its own truth
 
 case $what in
   parallel)
@@ -30,7 +31,7 @@ case $what in
     ls logs/*.txt.gz >logs.list
     mkdir -p out/fleet
     for i in 0 1 2; do
-      SLURM_ARRAY_TASK_ID=$i bash scripts/slurm_fleet.sbatch logs.list out/fleet --mode eskf >/dev/null \
+      SLURM_ARRAY_TASK_ID=$i bash scripts/slurm_fleet.sbatch logs.list out/fleet --mode eskf --truth auto >/dev/null \
         || fail "array task $i failed"
     done
     ./build/gins report out/fleet/*/ >report.out
@@ -43,6 +44,12 @@ for n in north south east; do
   grep -q "out/fleet/drive_$n .*logs/drive_$n.txt.gz *180.0" "$report" || { cat "$report"; fail "no report row for drive_$n"; }
 done
 grep -q "^3 runs, 0.15 h of log" "$report" || { cat "$report"; fail "the report's totals"; }
+# --truth auto: the log with a truth beside it is scored (the ESKF's 0.055 m), the others have no score.
+grep -q "out/fleet/drive_north .* 0\.055 " "$report" || { cat "$report"; fail "drive_north not scored against its truth"; }
+for n in south east; do
+  grep "out/fleet/drive_$n " "$report" | grep -q " 0\.0[0-9][0-9] " && { cat "$report"; fail "drive_$n scored without a truth"; }
+done
+grep -q '"truth"' out/fleet/drive_south/summary.json && fail "drive_south has a truth in its summary"
 cd /
 rm -rf "$work"
 echo "fleet ($what): three runs, one report row each"

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -89,7 +90,8 @@ class StateLines {
     if (format_ == "csv") {
       WriteStatesCsvLine(out_, e.x, e.sigma_p, e.sigma_v, e.sigma_att, e.odom_scale);
     } else if (format_ == "lla") {
-      WriteGeodeticCsvLine(out_, frame, e.x, e.sigma_p);
+      if (!geodetic_) geodetic_.emplace(frame);
+      WriteGeodeticCsvLine(out_, &*geodetic_, e.x, e.sigma_p);
     } else if (format_ == "nmea") {
       if (!OnNmeaGrid(e.x.t, nmea_.rate_hz, &next_nmea_t_)) return;
       if (e.x.t < kMinAbsoluteTime) {
@@ -121,6 +123,7 @@ class StateLines {
   std::string format_;
   NmeaExportOptions nmea_;
   double next_nmea_t_ = -1e300;
+  std::optional<NearGeodetic> geodetic_;  // lla: the run's conversion, so that the lines are its file's
   StateFilter filter_;
   uint64_t written_ = 0;
 };

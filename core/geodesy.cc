@@ -1,5 +1,6 @@
 #include "core/geodesy.h"
 
+#include <GeographicLib/Constants.hpp>
 #include <GeographicLib/LocalCartesian.hpp>
 #include <GeographicLib/NormalGravity.hpp>
 #include <cmath>
@@ -42,6 +43,37 @@ Mat3 LocalEnuFrame::RotationFromLocalEnu(const GeodeticPoint& p) const {
   Mat3 R_w_l;
   R_w_l << M[0], M[1], M[2], M[3], M[4], M[5], M[6], M[7], M[8];
   return R_w_l;
+}
+
+GeodeticPoint NearGeodetic::operator()(const Vec3& p_w) {
+  if (!p_w.allFinite()) return frame_.ToGeodetic(p_w);
+  // Near a pole the longitude's derivative blows up: exact there.
+  if (has_reference_ && std::abs(reference_.lat_deg) > 89.0) {
+    has_reference_ = false;
+    return frame_.ToGeodetic(p_w);
+  }
+  if (!has_reference_ || (p_w - reference_w_).squaredNorm() > kReach * kReach) {
+    reference_w_ = p_w;
+    reference_ = frame_.ToGeodetic(p_w);
+    has_reference_ = true;
+    // d(lat, lon, h) / d(east, north, up) at the reference: the meridian and prime-vertical radii of
+    // curvature (WGS84), after turning w's axes into the local ENU ones there.
+    const double a = GeographicLib::Constants::WGS84_a(), f = GeographicLib::Constants::WGS84_f();
+    const double e2 = f * (2.0 - f);
+    const double phi = reference_.lat_deg * M_PI / 180.0;
+    const double w = 1.0 - e2 * std::sin(phi) * std::sin(phi);
+    const double N = a / std::sqrt(w), M = a * (1.0 - e2) / (w * std::sqrt(w));
+    Mat3 d_local;
+    d_local << 0.0, 180.0 / M_PI / (M + reference_.alt_m), 0.0,  // latitude from north
+        180.0 / M_PI / ((N + reference_.alt_m) * std::cos(phi)), 0.0, 0.0,  // longitude from east
+        0.0, 0.0, 1.0;                                                      // height from up
+    d_geodetic_d_w_ = d_local * frame_.RotationFromLocalEnu(reference_).transpose();
+  }
+  const Vec3 d = d_geodetic_d_w_ * (p_w - reference_w_);
+  GeodeticPoint g{reference_.lat_deg + d.x(), reference_.lon_deg + d.y(), reference_.alt_m + d.z()};
+  if (g.lon_deg > 180.0) g.lon_deg -= 360.0;
+  if (g.lon_deg < -180.0) g.lon_deg += 360.0;
+  return g;
 }
 
 double LocalYawToWorld(const LocalEnuFrame& frame, const GeodeticPoint& p, double yaw_local) {

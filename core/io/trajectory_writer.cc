@@ -168,9 +168,9 @@ void WriteStatesCsv(FILE* f, const PoseFields& pose, const NavState& x, const Ve
 
 // The geodetic line from the fields already formatted: the time and, when a states line was written, its
 // position σ (the same formatting: WriteGeodeticCsvLine's bytes).
-bool WriteGeodetic(FILE* f, const LocalEnuFrame& frame, const PoseFields& pose, const Vec3& p_w, const Vec3& sp,
+bool WriteGeodetic(FILE* f, NearGeodetic* geodetic, const PoseFields& pose, const Vec3& p_w, const Vec3& sp,
                    const SigmaFields* sigma) {
-  const GeodeticPoint g = frame.ToGeodetic(p_w);
+  const GeodeticPoint g = (*geodetic)(p_w);
   if (!std::isfinite(g.lat_deg) || !std::isfinite(g.lon_deg) || !std::isfinite(g.alt_m)) return false;
   // 9 decimals of a degree: 0.1 mm, below the TUM file's 5 decimals of a metre.
   Line l;
@@ -206,13 +206,13 @@ StatesCsvWriter::StatesCsvWriter(const std::string& path) : file_(path) { file_.
 
 const char kGeodeticCsvColumns[] = "t,lat_deg,lon_deg,height_m,sigma_e_m,sigma_n_m,sigma_u_m\n";
 
-bool WriteGeodeticCsvLine(FILE* f, const LocalEnuFrame& frame, const NavState& x, const Vec3& sp) {
+bool WriteGeodeticCsvLine(FILE* f, NearGeodetic* geodetic, const NavState& x, const Vec3& sp) {
   if (!x.AllFinite() || !sp.allFinite()) return false;
-  return WriteGeodetic(f, frame, PoseFields(x), x.p_wb, sp, nullptr);
+  return WriteGeodetic(f, geodetic, PoseFields(x), x.p_wb, sp, nullptr);
 }
 
 GeodeticCsvWriter::GeodeticCsvWriter(const std::string& path, const LocalEnuFrame& frame)
-    : file_(path), frame_(frame) {
+    : file_(path), geodetic_(frame) {
   file_.Write(kGeodeticCsvColumns);
 }
 
@@ -240,7 +240,7 @@ bool TumWriter::AddWithStates(StatesCsvWriter* states, GeodeticCsvWriter* geodet
   const bool states_written = states != nullptr && StatesFinite(x, sp, sv, sa, odom_scale);
   if (states_written) WriteStatesCsv(states->stream(), pose, x, sp, sv, sa, odom_scale, &l, &sigma);
   if (geodetic != nullptr && sp.allFinite()) {
-    WriteGeodetic(geodetic->stream(), geodetic->frame(), pose, x.p_wb, sp, states_written ? &sigma : nullptr);
+    WriteGeodetic(geodetic->stream(), geodetic->geodetic(), pose, x.p_wb, sp, states_written ? &sigma : nullptr);
   }
   return true;
 }

@@ -46,7 +46,7 @@ bool WriteStatesCsvLine(FILE* f, const NavState& x, const Vec3& sigma_p, const V
 extern const char kStatesCsvColumns[];
 // The geodetic track: one line of "t,lat_deg,lon_deg,height_m,sigma_e_m,sigma_n_m,sigma_u_m" (§5.4), and
 // its first line.
-bool WriteGeodeticCsvLine(FILE* f, const LocalEnuFrame& frame, const NavState& x, const Vec3& sigma_p);
+bool WriteGeodeticCsvLine(FILE* f, NearGeodetic* geodetic, const NavState& x, const Vec3& sigma_p);
 extern const char kGeodeticCsvColumns[];
 
 class StatesCsvWriter;
@@ -85,14 +85,14 @@ class StatesCsvWriter {
 class GeodeticCsvWriter {
  public:
   GeodeticCsvWriter(const std::string& path, const LocalEnuFrame& frame);
-  bool Add(const NavState& x, const Vec3& sigma_p) { return WriteGeodeticCsvLine(file_.stream(), frame_, x, sigma_p); }
+  bool Add(const NavState& x, const Vec3& sigma_p) { return WriteGeodeticCsvLine(file_.stream(), &geodetic_, x, sigma_p); }
   void Commit() { file_.Commit(); }
   FILE* stream() { return file_.stream(); }
-  const LocalEnuFrame& frame() const { return frame_; }
+  NearGeodetic* geodetic() { return &geodetic_; }
 
  private:
   AtomicFile file_;
-  LocalEnuFrame frame_;
+  NearGeodetic geodetic_;
 };
 
 }  // namespace gins

@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-120}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(log_line log_reader config stream export_source)
+[ ${#targets[@]} -gt 0 ] || targets=(log_line log_reader config stream export_source gnss_formats)
 
 if ! command -v clang++ >/dev/null || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
   echo "gins fuzz: installing clang and libclang-rt-14-dev"

@@ -113,6 +113,26 @@ void LogWriter::Gnss(const GnssRecord& g) {
   ++records_;
 }
 
+void LogWriter::Odom(const OdomRecord& o) {
+  buf_ += "ODOM";
+  AppendNumber(&buf_, o.t);
+  AppendNumber(&buf_, o.left_pulses);
+  AppendNumber(&buf_, o.right_pulses);
+  Put("\n");
+  ++records_;
+}
+
+void LogWriter::Gvel(const GvelRecord& v) {
+  buf_ += "GVEL";
+  AppendNumber(&buf_, v.t);
+  for (int i = 0; i < 3; ++i) AppendNumber(&buf_, v.v_enu[i]);
+  if (v.has_sigma) {
+    for (int i = 0; i < 3; ++i) AppendNumber(&buf_, v.sigma_enu[i]);
+  }
+  Put("\n");
+  ++records_;
+}
+
 void LogWriter::Commit() {
   if (gzip_) {
     gzip_->Write(buf_, true, file_.stream());

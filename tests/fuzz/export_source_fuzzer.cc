@@ -2,7 +2,6 @@
 // tells apart (truth, geodetic track, states CSV, TUM), then converted and written in every format. Checks:
 // no crash, no hang, only InputError escapes (one line), the samples come out finite and strictly increasing
 // in time, and no format writes a "nan" or "inf".
-#include <unistd.h>
 
 #include <cmath>
 #include <cstddef>
@@ -15,20 +14,11 @@
 #include "core/io/geo_export.h"
 #include "core/io/geo_formats.h"
 #include "core/io/log_reader.h"
+#include "fuzz/fuzz_file.h"
 
 namespace {
 
-void Require(bool ok) {
-  if (!ok) std::abort();
-}
-
-std::string TempPath() {
-  static const std::string path = [] {
-    const char* dir = std::getenv("TMPDIR");
-    return std::string(dir != nullptr ? dir : "/tmp") + "/gins_export_source_fuzzer." + std::to_string(getpid());
-  }();
-  return path;
-}
+using gins::fuzz::Require;
 
 // Writes with `write` into memory and checks the text holds no non-finite number.
 template <typename F>
@@ -51,11 +41,8 @@ void RequireFiniteText(F write) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::string path = TempPath();
-  FILE* f = std::fopen(path.c_str(), "wb");
-  if (f == nullptr) return 0;
-  if (size > 0) std::fwrite(data, 1, size, f);
-  std::fclose(f);
+  const std::string path = gins::fuzz::WriteInput("export_source", data, size);
+  if (path.empty()) return 0;
   try {
     const gins::ExportSource src = gins::ReadExportSource(path, gins::GeodeticPoint{31.5, 120.4, 10.0});
     double last_t = -HUGE_VAL;

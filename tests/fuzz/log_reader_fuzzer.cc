@@ -1,7 +1,6 @@
 // libFuzzer target: the whole LogReader (plain or gzip, detected by content) on an arbitrary file, under
 // both damage policies and a small line-length limit. Checks: no crash, no hang, only InputError escapes,
 // records come out finite and non-decreasing in time, and every line is accounted for.
-#include <unistd.h>
 
 #include <cmath>
 #include <cstddef>
@@ -11,20 +10,11 @@
 #include <string>
 
 #include "core/io/log_reader.h"
+#include "fuzz/fuzz_file.h"
 
 namespace {
 
-void Require(bool ok) {
-  if (!ok) std::abort();
-}
-
-std::string TempPath() {
-  static const std::string path = [] {
-    const char* dir = std::getenv("TMPDIR");
-    return std::string(dir != nullptr ? dir : "/tmp") + "/gins_log_reader_fuzzer." + std::to_string(getpid());
-  }();
-  return path;
-}
+using gins::fuzz::Require;
 
 void ReadAll(const std::string& path, const gins::InputOptions& options) {
   try {
@@ -55,11 +45,8 @@ void ReadAll(const std::string& path, const gins::InputOptions& options) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::string path = TempPath();
-  FILE* f = std::fopen(path.c_str(), "wb");
-  if (f == nullptr) return 0;
-  if (size > 0) std::fwrite(data, 1, size, f);
-  std::fclose(f);
+  const std::string path = gins::fuzz::WriteInput("log_reader", data, size);
+  if (path.empty()) return 0;
   gins::InputOptions skip;
   skip.max_line_length = 200;  // small enough for the fuzzer to reach line_too_long
   skip.max_errors = 50;

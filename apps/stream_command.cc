@@ -94,7 +94,7 @@ class StateLines {
       WriteGeodeticCsvLine(out_, &*geodetic_, e.x, e.sigma_p);
     } else if (format_ == "nmea") {
       if (!OnNmeaGrid(e.x.t, nmea_.rate_hz, &next_nmea_t_)) return;
-      if (e.x.t < kMinAbsoluteTime) {
+      if (!HasDate(e.x.t)) {
         throw std::runtime_error("state at t=" + std::to_string(e.x.t) +
                                  " s: not an absolute time, NMEA needs the UTC date and time (docs/formats.md §2.6)");
       }

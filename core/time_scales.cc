@@ -1,5 +1,6 @@
 #include "core/time_scales.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -92,6 +93,8 @@ double UnixUtcToLogTime(double unix_utc, LogTimeScale scale) {
 }
 
 UtcCalendar ToUtcCalendar(double unix_utc) {
+  // In range of the day count's integer (a NaN to the epoch): no cast of an out-of-range double.
+  unix_utc = unix_utc == unix_utc ? std::min(std::max(unix_utc, -1e15), 1e15) : 0.0;
   const double days = std::floor(unix_utc / 86400.0);
   double sod = unix_utc - days * 86400.0;
   UtcCalendar c;

@@ -31,7 +31,8 @@ double UnixUtcToGps(double unix_utc);
 double LogTimeToUnixUtc(double t, LogTimeScale scale);
 double UnixUtcToLogTime(double unix_utc, LogTimeScale scale);
 
-// A Unix UTC time as a calendar date and time of day (proleptic Gregorian).
+// A Unix UTC time as a calendar date and time of day (proleptic Gregorian); times beyond ±1e15 s (30 million
+// years) are taken at that bound.
 struct UtcCalendar {
   int year = 1970, month = 1, day = 1;  // month 1-12, day 1-31
   int hour = 0, minute = 0;
@@ -46,5 +47,9 @@ std::string IsoUtc(double unix_utc, int decimals);
 // Time stamps below this (about 1983 on either scale) are not absolute: a log on a relative clock (seconds
 // since power-on, GPS seconds of the week) has no date to write.
 inline constexpr double kMinAbsoluteTime = 1.0e8;
+// Nor a time stamp at or beyond the log's own limit (docs/formats.md §2.6: below 1e10 s, the year 2286).
+inline constexpr double kMaxAbsoluteTime = 1.0e10;
+// A time with a date to write: in [kMinAbsoluteTime, kMaxAbsoluteTime).
+inline bool HasDate(double t) { return t >= kMinAbsoluteTime && t < kMaxAbsoluteTime; }
 
 }  // namespace gins

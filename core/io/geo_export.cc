@@ -204,12 +204,12 @@ bool OnNmeaGrid(double t, double rate_hz, double* next_t) {
 }
 
 void WriteNmea(const GeoTrack& track, const NmeaExportOptions& options, std::FILE* out) {
-  if (!track.samples.empty() && track.samples.front().t < kMinAbsoluteTime) {
-    throw InputError(track.name + ": times start at " + std::to_string(track.samples.front().t) +
-                     " s, not an absolute time: NMEA needs the UTC date and time (docs/formats.md §2.6)");
-  }
   double next_t = -1e300;
   for (const GeoSample& s : track.samples) {
+    if (!HasDate(s.t)) {
+      throw InputError(track.name + ": a state at t = " + std::to_string(s.t) +
+                       " s, not an absolute time: NMEA needs the UTC date and time (docs/formats.md §2.6)");
+    }
     if (OnNmeaGrid(s.t, options.rate_hz, &next_t)) WriteNmeaEpoch(s, QualityOf(track.no_fix, s), options, out);
   }
 }

@@ -51,8 +51,8 @@ struct NmeaExportOptions {
 // The GGA quality of an epoch: dead reckoning inside a no-fix interval, else from the horizontal 1-σ
 // (≤ 5 cm: 4, RTK fixed; ≤ 0.5 m: 5, RTK float; else 1), 1 without σ (docs/formats.md §5.7).
 NmeaQuality QualityOf(const std::vector<GeoInterval>& no_fix, const GeoSample& s);
-// The epochs as GGA and RMC (+ GST, HDT) sentences, CR LF ended. Refuses (InputError) a track whose times
-// are not absolute (below kMinAbsoluteTime): NMEA carries the UTC time of day and RMC the date.
+// The epochs as GGA and RMC (+ GST, HDT) sentences, CR LF ended. Refuses (InputError) a track with a time
+// that is not absolute (HasDate): NMEA carries the UTC time of day and RMC the date.
 void WriteNmea(const GeoTrack& track, const NmeaExportOptions& options, std::FILE* out);
 // One epoch's sentences (the time scale and sentence choice of `options`; its rate is the caller's).
 void WriteNmeaEpoch(const GeoSample& s, NmeaQuality quality, const NmeaExportOptions& options, std::FILE* out);

@@ -92,7 +92,7 @@ Layout BuildLayout(const GeoTrack& track) {
 
 // ISO UTC of a log time, or "" for a time without a date.
 std::string Utc(double t, const GeoWriteOptions& options) {
-  return t >= kMinAbsoluteTime ? IsoUtc(LogTimeToUnixUtc(t, options.time_scale), 3) : std::string();
+  return HasDate(t) ? IsoUtc(LogTimeToUnixUtc(t, options.time_scale), 3) : std::string();
 }
 
 // A feature's properties besides its name (which each format has its own element for); one list for the

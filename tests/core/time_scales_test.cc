@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace gins {
 namespace {
 
@@ -21,6 +23,17 @@ TEST(TimeScales, GpsToUtcAtAKnownInstant) {
   EXPECT_EQ(c.minute, 30);
   EXPECT_EQ(c.second, 22.0);
   EXPECT_EQ(IsoUtc(GpsToUnixUtc(1440437440.0), 0), "2025-08-28T17:30:22Z");
+}
+
+// Any double gives a calendar (the bound's), none an out-of-range cast; HasDate says which times have one.
+TEST(TimeScales, HugeTimesGiveTheBoundsCalendarAndNoDate) {
+  const UtcCalendar far = ToUtcCalendar(1.96769e+128);
+  EXPECT_EQ(far.year, ToUtcCalendar(1e15).year);
+  EXPECT_GT(far.year, 30000000);
+  EXPECT_EQ(ToUtcCalendar(std::nan("")).year, 1970);
+  EXPECT_TRUE(HasDate(1440437440.0));
+  EXPECT_FALSE(HasDate(5e7));
+  EXPECT_FALSE(HasDate(1e10));
 }
 
 TEST(TimeScales, TheGpsEpochHasNoLeapSeconds) {

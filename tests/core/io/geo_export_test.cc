@@ -142,6 +142,12 @@ TEST(GeoExport, NmeaEpochsFollowTheGridAndQualityTheSigmaAndOutages) {
   relative.samples.push_back(s);  // t = 50 s: not an absolute time
   std::FILE* sink = std::fopen("/dev/null", "w");
   EXPECT_THROW(WriteNmea(relative, NmeaExportOptions{}, sink), InputError);
+  GeoTrack beyond;  // past the log's 1e10 s limit (found by the export_source fuzzer: no date to write)
+  s.t = 1400000000.0;
+  beyond.samples.push_back(s);
+  s.t = 2e130;
+  beyond.samples.push_back(s);
+  EXPECT_THROW(WriteNmea(beyond, NmeaExportOptions{}, sink), InputError);
   std::fclose(sink);
 }
 

@@ -311,8 +311,11 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
   std::array<OutputStream*, 5> by_stream{};  // indexed by api::Stream: no look-up per state
   // Formatting and writing the outputs runs on a second thread, in the order the states come: at IMU rate
   // it costs about as much as the ESKF. Declared after `streams`, so it is joined before they close.
-  BatchPipe<std::pair<OutputStream*, api::State>> writer([](const std::pair<OutputStream*, api::State>& item) {
+  using Item = std::pair<OutputStream*, api::State>;
+  BatchPipe<Item> writer([&request](const Item& item) {
+    const uint64_t written = item.first->count();
     item.first->Add(api::ToStateEstimate(item.second));
+    if (request.on_output_state && item.first->count() > written) request.on_output_state(item.second);
   });
   // After what its callback uses: on an error the session (and its estimator threads) goes first.
   api::Session session(config, session_options);

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include <functional>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -29,6 +30,9 @@ struct RunRequest {
   std::string mode = "eskf";          // eskf | smoother | both
   std::string config_path;            // for the record only
   std::optional<std::string> truth_path;
+  // Optional: each state an output file holds, as it is written (after StateFilter; State::lla is NaN), on
+  // the writer thread, each stream's in time order. The Python package keeps them in memory this way.
+  std::function<void(const api::State&)> on_output_state;
 };
 
 struct RunResult {

@@ -24,6 +24,9 @@ LAYERS = {
     "public": ("apps/include/gins", []),
     "api": ("apps/api", ["core", "io", "eval", "sim", "factors", "solver", "config", "public"]),
     "apps": ("apps", ["core", "io", "eval", "sim", "factors", "solver", "config", "public", "api"]),
+    # The Python extension: the public API and `gins run` (apps), the error types Run throws (io, solver), the
+    # output files' number format (io) and the world frame's geodetic conversion (core), no other internals.
+    "python": ("apps/python", ["core", "io", "solver", "public", "apps"]),
 }
 # Include paths that are not the folder under the source root: the public header is included as
 # "gins/gins.h" (its include directory is apps/include, as once installed).

@@ -18,6 +18,7 @@ packages=("${extra[@]}"
   libgeographiclib-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
   libgtest-dev libgmock-dev
   python3 python3-numpy python3-matplotlib
+  python3-dev python3-pybind11 pybind11-dev python3-pytest  # the Python package gins (apps/python), its tests
   parallel  # docs/fleet.md's recipe, which the tests run
 )
 missing=()

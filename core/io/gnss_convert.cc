@@ -137,19 +137,8 @@ void AppendInput(const ConvertedInput& in, LogTimeScale scale, std::string* out)
   }
   for (const auto& [what, n] : s.dropped) *out += "    dropped " + what + ": " + Count(n) + "\n";
   for (const auto& [what, n] : s.ignored) *out += "    ignored " + what + ": " + Count(n) + "\n";
-  auto append = [&](const char* kind, const std::map<std::string, uint64_t>& counts) {
-    for (const auto& [reason, n] : counts) {
-      *out += FormatText("    %s %s: ", kind, reason.c_str()) + Count(n);
-      for (const InputIssue& issue : f.issues) {
-        if (issue.reason != reason) continue;
-        *out += " (first at line " + Count(issue.line) + ": " + issue.detail + ")";
-        break;
-      }
-      *out += "\n";
-    }
-  };
-  append("skipped", f.skipped);
-  append("warning", f.warnings);
+  *out += FormatIssueCounts("skipped", f.skipped, f.issues);
+  *out += FormatIssueCounts("warning", f.warnings, f.issues);
 }
 
 }  // namespace

@@ -346,19 +346,8 @@ void AppendFileSummary(const char* what, const ConvertedFile& f, std::string* ou
                      static_cast<unsigned long long>(f.written));
   if (f.has_range) *out += FormatText(", t %.3f .. %.3f s, %d columns", f.t_first, f.t_last, f.columns);
   *out += "\n";
-  auto append = [&](const char* kind, const std::map<std::string, uint64_t>& counts) {
-    for (const auto& [reason, n] : counts) {
-      *out += FormatText("    %s %s: %llu", kind, reason.c_str(), static_cast<unsigned long long>(n));
-      for (const InputIssue& issue : f.issues) {
-        if (issue.reason != reason) continue;
-        *out += FormatText(" (first at line %llu: ", static_cast<unsigned long long>(issue.line)) + issue.detail + ")";
-        break;
-      }
-      *out += "\n";
-    }
-  };
-  append("skipped", f.skipped);
-  append("warning", f.warnings);
+  *out += FormatIssueCounts("skipped", f.skipped, f.issues);
+  *out += FormatIssueCounts("warning", f.warnings, f.issues);
 }
 
 }  // namespace

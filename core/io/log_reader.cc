@@ -231,4 +231,19 @@ bool LogReader::stopped() const { return impl_->stopped(); }
 
 bool LogReader::Next(LogRecord* record) { return impl_->Next(record); }
 
+std::string FormatIssueCounts(const char* kind, const std::map<std::string, uint64_t>& counts,
+                              const std::vector<InputIssue>& issues) {
+  std::string out;
+  for (const auto& [reason, n] : counts) {
+    out += std::string("    ") + kind + " " + reason + ": " + std::to_string(n);
+    for (const InputIssue& issue : issues) {
+      if (issue.reason != reason) continue;
+      out += " (first at line " + std::to_string(issue.line) + ": " + issue.detail + ")";
+      break;
+    }
+    out += "\n";
+  }
+  return out;
+}
+
 }  // namespace gins

@@ -98,6 +98,11 @@ struct InputIssue {
   std::string detail;   // human-readable, e.g. "field 3 'abc' is not a number"
 };
 
+// A converter's summary lines of its damage, one per reason: "    <kind> <reason>: <n> (first at line L:
+// detail)\n", the detail of the first issue listed with that reason.
+std::string FormatIssueCounts(const char* kind, const std::map<std::string, uint64_t>& counts,
+                              const std::vector<InputIssue>& issues);
+
 struct ReadStats {
   uint64_t lines = 0;
   uint64_t imu = 0, odom = 0, gnss = 0, gvel = 0;  // records accepted

@@ -10,6 +10,7 @@
 
 #include "apps/convert_command.h"
 #include "apps/export_command.h"
+#include "apps/interrupt.h"
 #include "apps/eval_command.h"
 #include "apps/report_command.h"
 #include "apps/run_command.h"
@@ -128,7 +129,7 @@ std::string TruthBesideLog(const std::string& log) {
 
 }  // namespace
 
-int RunCli(int argc, const char* const* argv) {
+int RunCli(int argc, const char* const* argv, bool own_process) {
   if (!google::IsGoogleLoggingInitialized()) google::InitGoogleLogging("gins");
   FLAGS_logtostderr = true;
   FLAGS_minloglevel = google::GLOG_WARNING;
@@ -184,6 +185,7 @@ int RunCli(int argc, const char* const* argv) {
     }
     return RunStream(stream_req, 0, stdout);
   }
+  if (own_process) RemoveUnfinishedFilesOnInterrupt();
   if (*report) return RunReport(report_req);
   if (*eval) return RunEval(eval_req);
   if (*convert) return RunConvert(convert_req);

@@ -1,3 +1,3 @@
 #include "apps/cli.h"
 
-int main(int argc, char** argv) { return gins::RunCli(argc, argv); }
+int main(int argc, char** argv) { return gins::RunCli(argc, argv, /*own_process=*/true); }

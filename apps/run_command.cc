@@ -343,7 +343,8 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
     // the records before it, as from a direct read). Gone before read_stats is read.
     ReadAhead<api::Record> records([&reader](api::Record* r) { return reader.Next(r); });
     api::Record rec;
-    while (records.Next(&rec)) {
+    for (uint64_t n = 1; records.Next(&rec); ++n) {
+      if (request.poll && n % 4096 == 0) request.poll();
       try {
         session.Push(rec);
       } catch (const api::Error& e) {
@@ -357,8 +358,10 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
   CheckReadCounts(request.log_path, read_stats);
   FinishSession(request.log_path, &session);
   writer.Close();  // every state written (or the writer's error thrown) before the files are committed
+  if (request.poll) request.poll();  // and after the two-sided passes Finish runs
 
   RunResult result;
+  const CommitGroup commit;  // an interrupt from here on waits: all of the run's files, or none
   for (auto& [name, s] : streams) {
     for (auto& f : s->Commit(request.out_dir)) result.outputs.push_back(f);
   }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 
 #include <functional>
 #include <map>
@@ -33,6 +34,10 @@ struct RunRequest {
   // Optional: each state an output file holds, as it is written (after StateFilter; State::lla is NaN), on
   // the writer thread, each stream's in time order. The Python package keeps them in memory this way.
   std::function<void(const api::State&)> on_output_state;
+  // Optional: called on Run's own thread every 4096 records read and once before the files are committed;
+  // an exception it throws stops the run there (nothing is committed) and leaves Run as it is. The Python
+  // package checks for Ctrl-C this way.
+  std::function<void()> poll;
 };
 
 struct RunResult {

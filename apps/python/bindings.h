@@ -18,6 +18,15 @@ namespace gins::python {
 
 namespace py = pybind11;
 
+// Called without the GIL every kSignalCheckRecords records of a long call (gins.run, a vectorised push):
+// takes the GIL and raises, as a C++ exception, what a signal's Python handler raised (Ctrl-C's
+// KeyboardInterrupt), so the call stops there. PyErr_CheckSignals does nothing off the main thread.
+constexpr uint64_t kSignalCheckRecords = 4096;
+inline void RaisePendingSignals() {
+  py::gil_scoped_acquire gil;
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+}
+
 // A read-only numpy array over a std::vector it takes over (no copy): the array owns it through a capsule.
 template <typename T>
 py::array_t<T> ToNumpy(std::vector<T>&& values, std::vector<py::ssize_t> shape) {

@@ -110,6 +110,7 @@ py::tuple RunLog(const api::Config& config, const std::filesystem::path& log, co
   request.on_output_state = [&streams](const api::State& s) {
     streams.try_emplace(s.stream, false).first->second.Add(s);
   };
+  request.poll = RaisePendingSignals;  // Ctrl-C stops the run, nothing committed
   RunResult result;
   {
     py::gil_scoped_release release;

@@ -275,7 +275,10 @@ class PySession {
     bool* out = taken.mutable_data();
     {
       py::gil_scoped_release release;
-      for (py::ssize_t i = 0; i < n; ++i) out[i] = session_->Push(make(i));
+      for (py::ssize_t i = 0; i < n; ++i) {
+        if ((i + 1) % kSignalCheckRecords == 0) RaisePendingSignals();  // Ctrl-C: those before i are taken
+        out[i] = session_->Push(make(i));
+      }
     }
     return std::move(taken);
   }
@@ -393,7 +396,9 @@ uint64_t PySession::PushRecords(const py::object& log) {
       if (by_line) return a.line < b.line;
       return a.t < b.t || (a.t == b.t && a.type < b.type);
     });
+    uint64_t pushed = 0;
     for (const Entry& e : order) {
+      if (++pushed % kSignalCheckRecords == 0) RaisePendingSignals();  // Ctrl-C: those before e are taken
       bool ok = false;
       switch (e.type) {
         case 0:

@@ -6,7 +6,10 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <mutex>
+#include <set>
 #include <stdexcept>
+#include <string>
 
 #include "core/io/number_format.h"
 
@@ -51,12 +54,36 @@ class Line {
   char* end_ = buf_ + sizeof(buf_);
 };
 
+// The temporary files of the AtomicFiles not yet committed. Never destroyed: a signal's thread may use it
+// while the process ends. Recursive: a CommitGroup holds it around its files' commits.
+std::recursive_mutex& UncommittedLock() {
+  static auto* lock = new std::recursive_mutex;
+  return *lock;
+}
+std::set<std::string>& Uncommitted() {
+  static auto* files = new std::set<std::string>;
+  return *files;
+}
+
 }  // namespace
+
+size_t AbandonUncommittedFiles() {
+  UncommittedLock().lock();  // not released: the process ends
+  for (const std::string& f : Uncommitted()) ::unlink(f.c_str());
+  return Uncommitted().size();
+}
+
+CommitGroup::CommitGroup() { UncommittedLock().lock(); }
+CommitGroup::~CommitGroup() { UncommittedLock().unlock(); }
 
 AtomicFile::AtomicFile(const std::string& path)
     : path_(path), tmp_path_(path + ".tmp." + std::to_string(::getpid())) {
-  file_ = std::fopen(tmp_path_.c_str(), "wb");
-  if (file_ == nullptr) throw std::runtime_error(path_ + ": cannot create: " + std::strerror(errno));
+  {
+    const std::lock_guard<std::recursive_mutex> lock(UncommittedLock());
+    file_ = std::fopen(tmp_path_.c_str(), "wb");
+    if (file_ == nullptr) throw std::runtime_error(path_ + ": cannot create: " + std::strerror(errno));
+    Uncommitted().insert(tmp_path_);
+  }
   // Large buffer: trajectory files are written line by line at IMU rate. It must be ours: glibc ignores
   // the size when setvbuf allocates (it wrote 4 KiB at a time, one system call per ~15 lines).
   buffer_ = std::make_unique<char[]>(kBufferSize);
@@ -65,7 +92,10 @@ AtomicFile::AtomicFile(const std::string& path)
 
 AtomicFile::~AtomicFile() {
   if (file_ != nullptr) std::fclose(file_);
-  if (!committed_) std::remove(tmp_path_.c_str());
+  if (committed_) return;
+  const std::lock_guard<std::recursive_mutex> lock(UncommittedLock());
+  std::remove(tmp_path_.c_str());
+  Uncommitted().erase(tmp_path_);
 }
 
 void AtomicFile::Write(const std::string& text) { std::fwrite(text.data(), 1, text.size(), file_); }
@@ -79,10 +109,12 @@ void AtomicFile::Commit() {
   // The old file goes first: renaming over it would make ext4 write the new file's data out before the
   // rename returns (its replace-by-rename safeguard, ~0.1 s per hour of IMU-rate output). The new file
   // still appears complete or not at all.
+  const std::lock_guard<std::recursive_mutex> lock(UncommittedLock());
   std::remove(path_.c_str());
   if (std::rename(tmp_path_.c_str(), path_.c_str()) != 0) {
     throw std::runtime_error(path_ + ": cannot rename into place: " + std::strerror(errno));
   }
+  Uncommitted().erase(tmp_path_);
   committed_ = true;
 }
 

@@ -11,6 +11,8 @@
 
 namespace gins {
 
+// A file written under a temporary name and renamed into place by Commit(): it appears complete or not at
+// all. Until then its temporary file is listed process-wide, for AbandonUncommittedFiles.
 class AtomicFile {
  public:
   explicit AtomicFile(const std::string& path);  // throws std::runtime_error if it cannot be created
@@ -30,6 +32,21 @@ class AtomicFile {
   std::unique_ptr<char[]> buffer_;  // the stream's; outlives it (the destructor closes the stream first)
   FILE* file_ = nullptr;
   bool committed_ = false;
+};
+
+// For a process that is about to end on a signal (apps/interrupt.h): removes the temporary file of every
+// AtomicFile not yet committed and returns how many; no AtomicFile commits after it (it keeps the list's
+// lock). Waits for a CommitGroup that is committing.
+size_t AbandonUncommittedFiles();
+
+// Held while a set of files is committed (a run's outputs and its summary): AbandonUncommittedFiles waits
+// for it, so an interrupted process leaves all of the set or none.
+class CommitGroup {
+ public:
+  CommitGroup();
+  ~CommitGroup();
+  CommitGroup(const CommitGroup&) = delete;
+  CommitGroup& operator=(const CommitGroup&) = delete;
 };
 
 // The TUM file's comment line naming the mode and the world frame's origin (docs/formats.md §5.2).

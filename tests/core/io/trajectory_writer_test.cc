@@ -2,6 +2,12 @@
 #include "core/io/trajectory_writer.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 
 #include <cmath>
 #include <cstdio>
@@ -9,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -82,6 +89,48 @@ TEST(AtomicFile, CommittedFileHasTheContents) {
   ASSERT_TRUE(fs::exists(path));
   EXPECT_EQ(test::ReadFile(path), "line one\nline 2\n");
   EXPECT_EQ(DirEntries(dir), std::vector<std::string>{"out.txt"});
+}
+
+// What an interrupted process leaves (apps/interrupt.h): the committed file, not the uncommitted one's
+// temporary; a CommitGroup being committed is waited for. In a child: AbandonUncommittedFiles keeps its lock.
+TEST(AtomicFile, AbandonRemovesOnlyTheUncommittedAndWaitsForACommitGroup) {
+  const std::string dir = test::MakeTempDir("atomic_abandon");
+  std::fflush(stdout);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    AtomicFile done(dir + "/done.txt");
+    done.Write("done\n");
+    done.Commit();
+    auto* left = new AtomicFile(dir + "/left.txt");  // never destroyed: the process ends as on a signal
+    left->Write("half");
+    std::fflush(left->stream());
+    // A group committing on another thread: the abandon waits until both of its files are in place.
+    std::atomic<bool> holding{false};
+    std::thread group([&] {
+      const CommitGroup commit;
+      holding = true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      for (const char* name : {"/a.txt", "/b.txt"}) {
+        AtomicFile f(dir + name);
+        f.Write(name);
+        f.Commit();
+      }
+    });
+    while (!holding) std::this_thread::yield();
+    const size_t removed = AbandonUncommittedFiles();
+    const bool left_gone = !fs::exists(left->path()) && DirEntries(dir).size() == 3;
+    group.detach();  // done, or (had the abandon not waited) blocked for good on the list's lock
+    _exit(removed == 1 && left_gone ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  std::vector<std::string> names = DirEntries(dir);
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"a.txt", "b.txt", "done.txt"}));
+  EXPECT_EQ(test::ReadFile(dir + "/b.txt"), "/b.txt");
 }
 
 // Contents larger than the stream's own buffer (1 MiB) arrive whole and in order.

@@ -18,6 +18,7 @@
 #include "core/clock_checks.h"
 #include "core/imu_checks.h"
 #include "core/eval/gnss_outages.h"
+#include "core/io/log_record.h"
 #include "core/measurements.h"
 #include "core/standstill_detector.h"
 #include "core/initializer.h"
@@ -51,6 +52,8 @@ class Session {
   void AddOdom(const OdomRecord& odom);
   void AddGnss(const GnssRecord& fix);
   void AddGvel(const GvelRecord& vel);
+  // A log's record (or a simulated one) to the Add* of its type: the one dispatch before the estimators.
+  void Add(const LogRecord& r);
   // End of the data: flushes the estimators. Throws RunError if initialisation never completed.
   void Finish();
 
@@ -147,5 +150,18 @@ class Session {
   GnssGapTracker gnss_gaps_;
   uint64_t outage_dropped_ = 0, outage_kept_before_init_ = 0;
 };
+
+inline void Session::Add(const LogRecord& r) {
+  switch (r.type) {
+    case LogRecord::Type::kImu:
+      return AddImu(r.imu);
+    case LogRecord::Type::kOdom:
+      return AddOdom(r.odom);
+    case LogRecord::Type::kGnss:
+      return AddGnss(r.gnss);
+    case LogRecord::Type::kGvel:
+      return AddGvel(r.gvel);
+  }
+}
 
 }  // namespace gins

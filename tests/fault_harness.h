@@ -21,22 +21,7 @@
 
 namespace gins::test {
 
-inline void SetTime(SimRecord* r, double t) {
-  switch (r->type) {
-    case SimRecord::Type::kImu:
-      r->imu.t = t;
-      break;
-    case SimRecord::Type::kOdom:
-      r->odom.t = t;
-      break;
-    case SimRecord::Type::kGnss:
-      r->gnss.t = t;
-      break;
-    case SimRecord::Type::kGvel:
-      r->gvel.t = t;
-      break;
-  }
-}
+inline void SetTime(SimRecord* r, double t) { r->set_t(t); }
 
 // What the log reader (core/io/log_reader.h) lets through of a stream whose time stamps were edited: a record
 // older than the newest one is out_of_order, a second record of one type on one stamp a duplicate; both are

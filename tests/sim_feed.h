@@ -6,21 +6,6 @@
 
 namespace gins::test {
 
-inline void FeedSession(Session* session, const SimRecord& rec) {
-  switch (rec.type) {
-    case SimRecord::Type::kImu:
-      session->AddImu(rec.imu);
-      break;
-    case SimRecord::Type::kOdom:
-      session->AddOdom(rec.odom);
-      break;
-    case SimRecord::Type::kGnss:
-      session->AddGnss(rec.gnss);
-      break;
-    case SimRecord::Type::kGvel:
-      session->AddGvel(rec.gvel);
-      break;
-  }
-}
+inline void FeedSession(Session* session, const SimRecord& rec) { session->Add(rec); }
 
 }  // namespace gins::test

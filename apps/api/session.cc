@@ -114,22 +114,7 @@ bool Session::Impl::Push(LogRecord record) {
   return true;
 }
 
-void Session::Impl::Dispatch(const LogRecord& r) {
-  switch (r.type) {
-    case LogRecord::Type::kImu:
-      session_.AddImu(r.imu);
-      break;
-    case LogRecord::Type::kOdom:
-      session_.AddOdom(r.odom);
-      break;
-    case LogRecord::Type::kGnss:
-      session_.AddGnss(r.gnss);
-      break;
-    case LogRecord::Type::kGvel:
-      session_.AddGvel(r.gvel);
-      break;
-  }
-}
+void Session::Impl::Dispatch(const LogRecord& r) { session_.Add(r); }
 
 void Session::Impl::Finish() {
   if (finished_) throw Error(Error::Kind::kUsage, "gins::api::Session: Finish called twice");

@@ -101,19 +101,6 @@ void CheckTimeBases(const ConvertedInput& imu, const ConvertedInput& gnss) {
                    g.path + " do not overlap: " + hint);
 }
 
-void Write(const LogRecord& r, LogWriter* out) {
-  switch (r.type) {
-    case LogRecord::Type::kImu:
-      return out->Imu(r.imu);
-    case LogRecord::Type::kOdom:
-      return out->Odom(r.odom);
-    case LogRecord::Type::kGnss:
-      return out->Gnss(r.gnss);
-    case LogRecord::Type::kGvel:
-      return out->Gvel(r.gvel);
-  }
-}
-
 std::string Count(uint64_t n) { return std::to_string(n); }
 
 void AppendInput(const ConvertedInput& in, LogTimeScale scale, std::string* out) {
@@ -179,7 +166,7 @@ GnssConversion ConvertGnss(const GnssConvertInputs& in, const InputOptions& opti
     }
     if (next < 0) break;
     const LogRecord& r = head[next];
-    Write(r, &out);
+    out.Add(r);
     if (total++ == 0) c.t_first = r.t();
     c.t_last = std::max(c.t_last, r.t());
     ++c.written[static_cast<int>(r.type)];

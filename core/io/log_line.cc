@@ -324,34 +324,6 @@ LineParse CheckLogRecord(LogRecord* record, InputIssue* issue, const ImuRange& r
   return LineParse::kRecord;
 }
 
-double LogRecord::t() const {
-  switch (type) {
-    case Type::kImu:
-      return imu.t;
-    case Type::kOdom:
-      return odom.t;
-    case Type::kGnss:
-      return gnss.t;
-    case Type::kGvel:
-      return gvel.t;
-  }
-  return imu.t;
-}
-
-const char* LogRecordTypeName(LogRecord::Type type) {
-  switch (type) {
-    case LogRecord::Type::kImu:
-      return "IMU";
-    case LogRecord::Type::kOdom:
-      return "ODOM";
-    case LogRecord::Type::kGnss:
-      return "GNSS";
-    case LogRecord::Type::kGvel:
-      return "GVEL";
-  }
-  return "?";
-}
-
 LineParse ParseLogLine(std::string_view line, LogRecord* record, InputIssue* issue, const ImuRange& range) {
   if (const void* hash = std::memchr(line.data(), '#', line.size())) {
     line = line.substr(0, static_cast<const char*>(hash) - line.data());

@@ -26,6 +26,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/io/log_record.h"
 #include "core/io/text_input.h"
 #include "core/measurements.h"
 
@@ -75,22 +76,6 @@ struct InputOptions {
                                      // sensor's grid when a logger jittered them (core/io/sample_clock.h)
   ImuRange imu_range;                // not an input.* key: the imu.* range (ReaderOptions)
 };
-
-
-struct LogRecord {
-  enum class Type { kImu, kOdom, kGnss, kGvel };
-  static constexpr int kNumTypes = 4;
-  Type type = Type::kImu;
-  uint64_t line = 0;  // 1-based line number in the file
-  ImuSample imu;      // valid when type == kImu
-  OdomRecord odom;    // valid when type == kOdom
-  GnssRecord gnss;    // valid when type == kGnss
-  GvelRecord gvel;    // valid when type == kGvel
-  double t() const;
-};
-
-// "IMU", "ODOM", "GNSS" or "GVEL": the record's type token.
-const char* LogRecordTypeName(LogRecord::Type type);
 
 struct InputIssue {
   uint64_t line = 0;

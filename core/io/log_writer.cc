@@ -133,6 +133,19 @@ void LogWriter::Gvel(const GvelRecord& v) {
   ++records_;
 }
 
+void LogWriter::Add(const LogRecord& r) {
+  switch (r.type) {
+    case LogRecord::Type::kImu:
+      return Imu(r.imu);
+    case LogRecord::Type::kOdom:
+      return Odom(r.odom);
+    case LogRecord::Type::kGnss:
+      return Gnss(r.gnss);
+    case LogRecord::Type::kGvel:
+      return Gvel(r.gvel);
+  }
+}
+
 void LogWriter::Commit() {
   if (gzip_) {
     gzip_->Write(buf_, true, file_.stream());

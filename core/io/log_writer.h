@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 
+#include "core/io/log_record.h"
 #include "core/io/trajectory_writer.h"
 #include "core/measurements.h"
 
@@ -27,6 +28,7 @@ class LogWriter {
   void Gnss(const GnssRecord& g);   // GNSS t lat lon alt heading valid [σe σn σu]
   void Odom(const OdomRecord& o);   // ODOM t left_pulses right_pulses
   void Gvel(const GvelRecord& v);   // GVEL t ve vn vu [σe σn σu]
+  void Add(const LogRecord& r);     // the one of the four its type names
   // Finishes the file and renames it into place; throws std::runtime_error on any I/O error. Without
   // Commit() the file never appears.
   void Commit();

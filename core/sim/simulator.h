@@ -69,6 +69,7 @@
 
 #include "core/conventions.h"
 #include "core/geodesy.h"
+#include "core/io/log_record.h"
 #include "core/measurements.h"
 #include "core/nav_state.h"
 
@@ -205,31 +206,11 @@ class TruthTrajectory {
   std::vector<Vec3> knot_p_;   // p_wb at the knots
 };
 
-// One simulated log record with the truth at its time.
-struct SimRecord {
-  enum class Type { kImu, kOdom, kGnss, kGvel };
-  Type type = Type::kImu;
-  ImuSample imu;    // valid when type == kImu
-  OdomRecord odom;  // valid when type == kOdom
-  GnssRecord gnss;  // valid when type == kGnss
-  GvelRecord gvel;  // valid when type == kGvel
+// One simulated log record (line 0) with the truth at its time.
+struct SimRecord : LogRecord {
   // Truth at t() with the true IMU biases of the latest IMU sample (exact for IMU records).
   NavState truth;
   bool gnss_outlier = false;  // this fix was displaced as an outlier
-
-  double t() const {
-    switch (type) {
-      case Type::kImu:
-        return imu.t;
-      case Type::kOdom:
-        return odom.t;
-      case Type::kGnss:
-        return gnss.t;
-      case Type::kGvel:
-        return gvel.t;
-    }
-    return gnss.t;
-  }
 };
 
 // The measurement stream of a drive, generated lazily in time order.

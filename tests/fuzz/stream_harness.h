@@ -101,20 +101,7 @@ inline StreamResult RunStream(const uint8_t* data, size_t size) {
     newest_t = r.t();
     ++result.records;
     try {
-      switch (r.type) {
-        case LogRecord::Type::kImu:
-          session.AddImu(r.imu);
-          break;
-        case LogRecord::Type::kOdom:
-          session.AddOdom(r.odom);
-          break;
-        case LogRecord::Type::kGnss:
-          session.AddGnss(r.gnss);
-          break;
-        case LogRecord::Type::kGvel:
-          session.AddGvel(r.gvel);
-          break;
-      }
+      session.Add(r);
     } catch (const RunError& e) {
       result.refused = e.what();  // the sanity checks: gins run stops here, with the reason
       return result;

@@ -1,0 +1,29 @@
+// A record of the log (docs/formats.md §3), the one record type below the public API: what the reader yields,
+// what the simulator generates (core/sim/simulator.h: SimRecord, with its truth), what the writer writes and
+// what the solver's Session takes (Session::Add). A switch over Type is written where a type's own code is
+// chosen (parsing, writing, dispatch), never for the time stamp.
+#pragma once
+
+#include <cstdint>
+
+#include "core/measurements.h"
+
+namespace gins {
+
+struct LogRecord {
+  enum class Type { kImu, kOdom, kGnss, kGvel };
+  static constexpr int kNumTypes = 4;
+  Type type = Type::kImu;
+  uint64_t line = 0;  // 1-based line number in the file
+  ImuSample imu;      // valid when type == kImu
+  OdomRecord odom;    // valid when type == kOdom
+  GnssRecord gnss;    // valid when type == kGnss
+  GvelRecord gvel;    // valid when type == kGvel
+  double t() const;
+  void set_t(double t);  // of the member that type names
+};
+
+// "IMU", "ODOM", "GNSS" or "GVEL": the record's type token.
+const char* LogRecordTypeName(LogRecord::Type type);
+
+}  // namespace gins

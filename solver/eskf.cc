@@ -73,7 +73,8 @@ void Eskf::Initialize(const InitResult& init) {
   watchdog_.Clear();
   initialized_ = true;
   if (on_rts_) {
-    rts_ = std::make_unique<EskfRts>(options_);
+    rts_ = std::make_unique<EskfRts>(BridgeNoise{options_.imu.gyro_noise_density, options_.imu.acc_noise_density},
+                                     options_.eskf.estimate_gravity);
     rts_->StartChain(Nominal(), P_);
   }
   if (on_state_) on_state_(Estimate());

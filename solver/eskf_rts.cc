@@ -68,8 +68,7 @@ struct EskfRts::Node {
   }
 };
 
-EskfRts::EskfRts(const EstimatorOptions& options)
-    : options_(options), with_gravity_(options.eskf.estimate_gravity) {
+EskfRts::EskfRts(const BridgeNoise& noise, bool with_gravity) : noise_(noise), with_gravity_(with_gravity) {
   nodes_file_ = std::tmpfile();
   steps_file_ = std::tmpfile();
   if (nodes_file_ == nullptr || steps_file_ == nullptr) {
@@ -205,7 +204,7 @@ void EskfRts::Smooth(const EarthModel& earth, const StateCallback& out) {
     failed_ = true;
     return;
   }
-  const BridgeNoise noise{options_.imu.gyro_noise_density, options_.imu.acc_noise_density};
+  const BridgeNoise& noise = noise_;
   std::vector<HeldImuSample> steps;
   for (size_t i = 0; i < nodes_; ++i) {
     const uint64_t end = i + 1 < nodes_ ? first_step_[i + 1] : steps_;

@@ -25,7 +25,7 @@
 #include "core/imu_kernel.h"
 #include "solver/eskf_state.h"
 #include "solver/estimator.h"
-#include "solver/estimator_options.h"
+#include "solver/imu_bridge.h"
 #include "solver/keyframe.h"
 
 namespace gins {
@@ -54,7 +54,8 @@ class EskfRts {
   using MatP = Eigen::Matrix<double, eskf::kDim, eskf::kDim>;
   using VecP = Eigen::Matrix<double, eskf::kDim, 1>;
 
-  explicit EskfRts(const EstimatorOptions& options);
+  // noise: the IMU's, for the output bridges between nodes; with_gravity: eskf.estimate_gravity.
+  EskfRts(const BridgeNoise& noise, bool with_gravity);
   ~EskfRts();
   EskfRts(const EskfRts&) = delete;
   EskfRts& operator=(const EskfRts&) = delete;
@@ -82,7 +83,7 @@ class EskfRts {
   void Write(const Node& node);
   bool Read(size_t index, Node* node);
 
-  EstimatorOptions options_;
+  BridgeNoise noise_;
   bool with_gravity_ = false;
   std::FILE* nodes_file_ = nullptr;  // fixed-size node records, in time order
   std::FILE* steps_file_ = nullptr;  // the IMU steps, in time order

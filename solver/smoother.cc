@@ -43,10 +43,11 @@ Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, Stat
       watchdog_(options.watchdog) {
   window_.SetLog(factor_log_.get());
   attachers_.push_back(std::make_unique<VehicleAttacher>(options_));
-  attachers_.push_back(std::make_unique<StandstillAttacher>(options_));
-  attachers_.push_back(std::make_unique<GvelAttacher>(options_));
+  attachers_.push_back(
+      std::make_unique<StandstillAttacher>(options_.standstill, options_.imu, options_.wheel.gate_probability));
+  attachers_.push_back(std::make_unique<GvelAttacher>(options_.gnss));
   attachers_.push_back(std::make_unique<GnssAttacher>(
-      options_, [this](double t, bool accepted) { WatchGnss(t, accepted); },
+      options_.gnss, [this](double t, bool accepted) { WatchGnss(t, accepted); },
       [this](double factor) { RelievePrior(factor); }));
 }
 

@@ -122,13 +122,13 @@ Vec3 AttachContext::Acceleration(const NavState& x) const {
 
 // --- GNSS -------------------------------------------------------------------------------------------------
 
-GnssAttacher::GnssAttacher(const EstimatorOptions& options, std::function<void(double, bool)> on_checked,
+GnssAttacher::GnssAttacher(const GnssOptions& gnss, std::function<void(double, bool)> on_checked,
                            std::function<void(double)> on_reacquired)
-    : options_(options),
+    : gnss_(gnss),
       on_checked_(std::move(on_checked)),
       on_reacquired_(std::move(on_reacquired)),
-      gate_position_(Chi2Gate(options.gnss.gate_probability, 3)),
-      gate_heading_(Chi2Gate(options.gnss.gate_probability, 1)),
+      gate_position_(Chi2Gate(gnss.gate_probability, 3)),
+      gate_heading_(Chi2Gate(gnss.gate_probability, 1)),
       // A gate of +∞ (probability 0) leaves no corner: then no loss, as the ESKF has none.
       loss_position_(std::isfinite(gate_position_) ? new ceres::HuberLoss(std::sqrt(gate_position_)) : nullptr),
       loss_heading_(std::isfinite(gate_heading_) ? new ceres::HuberLoss(std::sqrt(gate_heading_)) : nullptr) {}
@@ -137,30 +137,30 @@ bool GnssAttacher::OnGnss(const GnssMeasurement& m, const AttachContext& ctx) {
   const Prediction pred = ctx.predict(m.t);
   const bool position = AttachPosition(m, pred, ctx);
   // A heading attached beside a rejected fix is a measurement too: the window must be solved for it.
-  const bool heading = m.heading_valid && options_.gnss.use_heading && AttachHeading(m, ctx.predict(m.t), ctx);
+  const bool heading = m.heading_valid && gnss_.use_heading && AttachHeading(m, ctx.predict(m.t), ctx);
   return position || heading;
 }
 
 ceres::CostFunction* GnssAttacher::PositionFactor(const GnssMeasurement& m, const Prediction& pred, const Anchor& a,
                                                   const AttachContext& ctx, std::vector<BlockRef>* blocks) const {
   if (TimeOffsetEstimated(ctx)) {
-    return DelayedFactor(GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), options_.gnss.lever_b}, a, pred, ctx, blocks);
+    return DelayedFactor(GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), gnss_.lever_b}, a, pred, ctx, blocks);
   }
   if (a.partial == nullptr) {
     *blocks = {{a.kf, BlockType::kPose}};
-    return GnssFactor::Create(m.p_w, m.sigma_w, options_.gnss.lever_b);
+    return GnssFactor::Create(m.p_w, m.sigma_w, gnss_.lever_b);
   }
   *blocks = {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}};
   return PreintAttachedFactor<GnssAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb),
-                                                  GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), options_.gnss.lever_b});
+                                                  GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), gnss_.lever_b});
 }
 
 bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx) {
   const StateBlocks at(pred.x, ctx.keyframes);
   const GateCheck gate =
       TimeOffsetEstimated(ctx)
-          ? DelayedCheck(GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), options_.gnss.lever_b}, pred, at, ctx)
-          : StampCheck(GnssFactor::Create(m.p_w, m.sigma_w, options_.gnss.lever_b), at, false, pred, ctx);
+          ? DelayedCheck(GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), gnss_.lever_b}, pred, at, ctx)
+          : StampCheck(GnssFactor::Create(m.p_w, m.sigma_w, gnss_.lever_b), at, false, pred, ctx);
   const double inflation = inflation_.factor();
   const FactorCheck plain = gate.Run();
   const FactorCheck check = inflation > 1.0 ? gate.Run(inflation) : plain;
@@ -199,17 +199,17 @@ bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pr
 
 bool GnssAttacher::AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx) {
   const StateBlocks at(pred.x, ctx.keyframes);
-  const HeadingAtTime model{m.yaw_G, 1.0 / m.sigma_yaw, options_.gnss.mount_yaw};
+  const HeadingAtTime model{m.yaw_G, 1.0 / m.sigma_yaw, gnss_.mount_yaw};
   const GateCheck gate =
       TimeOffsetEstimated(ctx)
           ? DelayedCheck(model, pred, at, ctx)
-          : StampCheck(HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw), at, false, pred, ctx);
+          : StampCheck(HeadingFactor::Create(m.yaw_G, m.sigma_yaw, gnss_.mount_yaw), at, false, pred, ctx);
   const FactorCheck check = gate.Run();
   const auto factor = [&](const Anchor& a, std::vector<BlockRef>* blocks) -> ceres::CostFunction* {
     if (TimeOffsetEstimated(ctx)) return DelayedFactor(model, a, pred, ctx, blocks);
     if (a.partial == nullptr) {
       *blocks = {{a.kf, BlockType::kPose}};
-      return HeadingFactor::Create(m.yaw_G, m.sigma_yaw, options_.gnss.mount_yaw);
+      return HeadingFactor::Create(m.yaw_G, m.sigma_yaw, gnss_.mount_yaw);
     }
     *blocks = {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}};
     return PreintAttachedFactor<HeadingAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb), model);
@@ -237,20 +237,20 @@ void GnssAttacher::AddStats(nlohmann::json* stats) const {
 
 // --- GNSS velocity ----------------------------------------------------------------------------------------
 
-GvelAttacher::GvelAttacher(const EstimatorOptions& options)
-    : options_(options),
-      gate_(Chi2Gate(options.gnss.gate_probability, 3)),
+GvelAttacher::GvelAttacher(const GnssOptions& gnss)
+    : lever_b_(gnss.lever_b),
+      gate_(Chi2Gate(gnss.gate_probability, 3)),
       loss_(std::isfinite(gate_) ? new ceres::HuberLoss(std::sqrt(gate_)) : nullptr) {}
 
 bool GvelAttacher::OnGvel(const GvelMeasurement& m, const AttachContext& ctx) {
   const Prediction pred = ctx.predict(m.t);
   const StateBlocks at(pred.x, ctx.keyframes);
   const Vec3 omega_b = ctx.BodyRate(pred.x);
-  const GvelAtTime model{m.v_w, m.sigma_w.cwiseInverse(), omega_b, options_.gnss.lever_b};
+  const GvelAtTime model{m.v_w, m.sigma_w.cwiseInverse(), omega_b, lever_b_};
   const GateCheck gate =
       TimeOffsetEstimated(ctx)
           ? DelayedCheck(model, pred, at, ctx)
-          : StampCheck(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, options_.gnss.lever_b), at, true, pred, ctx);
+          : StampCheck(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, lever_b_), at, true, pred, ctx);
   const FactorCheck check = gate.Run();
   if (!check.Passes(gate_)) {
     counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
@@ -262,7 +262,7 @@ bool GvelAttacher::OnGvel(const GvelMeasurement& m, const AttachContext& ctx) {
     ceres::CostFunction* cost = DelayedFactor(model, a, pred, ctx, &blocks);
     ctx.keyframes.AddFactor(cost, loss_.get(), blocks);
   } else if (a.partial == nullptr) {
-    ctx.keyframes.AddFactor(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, options_.gnss.lever_b), loss_.get(),
+    ctx.keyframes.AddFactor(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, lever_b_), loss_.get(),
                             {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}});
   } else {
     ctx.keyframes.AddFactor(
@@ -275,9 +275,11 @@ bool GvelAttacher::OnGvel(const GvelMeasurement& m, const AttachContext& ctx) {
 
 // --- Standstill -------------------------------------------------------------------------------------------
 
-StandstillAttacher::StandstillAttacher(const EstimatorOptions& options)
-    : options_(options),
-      gate_(Chi2Gate(options.wheel.gate_probability, 3)),  // standstill.* has no gate
+StandstillAttacher::StandstillAttacher(const StandstillOptions& standstill, const ImuOptions& imu,
+                                       double gate_probability)
+    : standstill_(standstill),
+      imu_(imu),
+      gate_(Chi2Gate(gate_probability, 3)),
       gate_zero_rate_(Chi2Gate(kZeroRateGateProbability, 3)) {}
 
 void StandstillAttacher::OnStandstill(const StandstillMeasurement& m, const AttachContext& ctx) {
@@ -290,7 +292,7 @@ void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
   const StandstillMeasurement& s = *last_;
   if (kf.t < s.since || kf.t > s.t + kStandstillReach) return;
   const Prediction pred = ctx.predict(kf.t);
-  if (!StandstillPlausible(pred.x.v_w, options_.standstill)) {
+  if (!StandstillPlausible(pred.x.v_w, standstill_)) {
     counts_.Reject("moving", kf.t);  // a quiet IMU at speed: not a stop
     return;
   }
@@ -303,14 +305,14 @@ void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
     const double sigma_tilt = std::sqrt(std::max(att_w(0, 0), att_w(1, 1)));
     const double sigma_ba = std::sqrt(SubCovariance(types, pred.cov, {BlockType::kBias}).diagonal().tail<3>().maxCoeff());
     if (AcceleratingWithoutWitness(s, pred.x, ctx.earth.Gravity(pred.x.p_wb), sigma_tilt, sigma_ba,
-                                   options_.imu.acc_noise_density)) {
+                                   imu_.acc_noise_density)) {
       counts_.Reject("accelerating", kf.t);  // braking smoothly, nothing to say it stopped
       return;
     }
   }
   // A quiet IMU during a smooth start or a constant acceleration can look like a stop: a zero velocity
   // the predicted velocity disagrees with is not taken.
-  ZeroVelocityFactor check(options_.standstill.velocity_sigma);
+  ZeroVelocityFactor check(standstill_.velocity_sigma);
   const Vec3 v = pred.x.v_w;
   const FactorCheck c = CheckFactor(check, {v.data()}, {BlockKind::kEuclidean},
                                     SubCovariance(ctx.keyframes.EstimatedTypes(), pred.cov, {BlockType::kVelocity}));
@@ -318,7 +320,7 @@ void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
     counts_.Reject("chi2_gate", kf.t);
     return;
   }
-  ctx.keyframes.AddFactor(new ZeroVelocityFactor(options_.standstill.velocity_sigma), nullptr,
+  ctx.keyframes.AddFactor(new ZeroVelocityFactor(standstill_.velocity_sigma), nullptr,
                           {{&kf, BlockType::kVelocity}});
   ++counts_.used;
   standing_[kf.id] = s.since;
@@ -338,7 +340,7 @@ void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
   }
   bool turning = true;
   if (span > 0.0) {
-    const double sigma = ZeroRateSigma(options_.imu.gyro_noise_density, span);
+    const double sigma = ZeroRateSigma(imu_.gyro_noise_density, span);
     const Vec3 r = pred.x.bg + pred.x.q_wb.conjugate() * ctx.earth.rate_w() - integral / span;
     const Mat3 S = SubCovariance(ctx.keyframes.EstimatedTypes(), pred.cov, {BlockType::kBias}).topLeftCorner<3, 3>() +
                    sigma * sigma * Mat3::Identity();
@@ -351,7 +353,7 @@ void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {
     ++zero_rotation_.used;
   }
   const double sigma_theta = turning ? std::numeric_limits<double>::infinity()
-                                     : std::max(2.0 * options_.imu.gyro_noise_density * std::sqrt(kf.t - prev.t), 1e-6);
+                                     : std::max(2.0 * imu_.gyro_noise_density * std::sqrt(kf.t - prev.t), 1e-6);
   ++zero_motion_factors_;
   ctx.keyframes.AddFactor(ZeroMotionFactor::Create(kStandstillPositionSigma, sigma_theta), nullptr,
                           {{&prev, BlockType::kPose}, {&kf, BlockType::kPose}});

@@ -116,7 +116,7 @@ class GnssAttacher final : public MeasurementAttacher {
  public:
   // on_checked(t, accepted): each fix's outcome, for the smoother's watchdog; on_reacquired(factor): a fix
   // was accepted under an inflated gate (the window was overconfident by about that factor).
-  GnssAttacher(const EstimatorOptions& options, std::function<void(double t, bool accepted)> on_checked,
+  GnssAttacher(const GnssOptions& gnss, std::function<void(double t, bool accepted)> on_checked,
                std::function<void(double factor)> on_reacquired);
 
   bool OnGnss(const GnssMeasurement& m, const AttachContext& ctx) override;
@@ -131,7 +131,7 @@ class GnssAttacher final : public MeasurementAttacher {
   bool AttachPosition(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
   bool AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
 
-  EstimatorOptions options_;
+  GnssOptions gnss_;
   std::function<void(double, bool)> on_checked_;
   std::function<void(double)> on_reacquired_;
   double gate_position_, gate_heading_;
@@ -142,12 +142,12 @@ class GnssAttacher final : public MeasurementAttacher {
 
 class GvelAttacher final : public MeasurementAttacher {
  public:
-  explicit GvelAttacher(const EstimatorOptions& options);
+  explicit GvelAttacher(const GnssOptions& gnss);
   bool OnGvel(const GvelMeasurement& m, const AttachContext& ctx) override;
   void AddStats(nlohmann::json* stats) const override { (*stats)["gnss_velocity"] = counts_.ToJson(); }
 
  private:
-  EstimatorOptions options_;
+  Vec3 lever_b_;
   double gate_;
   std::unique_ptr<ceres::LossFunction> loss_;
   MeasurementCounts counts_;
@@ -155,7 +155,8 @@ class GvelAttacher final : public MeasurementAttacher {
 
 class StandstillAttacher final : public MeasurementAttacher {
  public:
-  explicit StandstillAttacher(const EstimatorOptions& options);
+  // gate_probability: the zero velocity's χ² gate (standstill.* has none: the wheels', wheel.gate_probability).
+  StandstillAttacher(const StandstillOptions& standstill, const ImuOptions& imu, double gate_probability);
 
   void OnStandstill(const StandstillMeasurement& m, const AttachContext& ctx) override;
   void OnKeyframeCreated(Keyframe& kf, const AttachContext& ctx) override { Attach(kf, ctx); }
@@ -167,7 +168,8 @@ class StandstillAttacher final : public MeasurementAttacher {
  private:
   void Attach(Keyframe& kf, const AttachContext& ctx);
 
-  EstimatorOptions options_;
+  StandstillOptions standstill_;
+  ImuOptions imu_;
   double gate_;            // χ² gate on the zero velocity (3 dof)
   double gate_zero_rate_;  // and on the zero rotation (kZeroRateGateProbability, 3 dof)
   std::optional<StandstillMeasurement> last_;

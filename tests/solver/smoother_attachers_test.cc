@@ -99,7 +99,7 @@ GnssMeasurement Fix(double t, const Vec3& p_w) {
 TEST_F(AttacherTest, GnssFixIsCheckedAgainstThePredictionAndAttachedAtItsEpoch) {
   Push(10.0, 10.0);  // at (100, 0, 0), σ_p 5 cm
   std::vector<std::pair<double, bool>> outcomes;
-  GnssAttacher gnss(options_, [&](double t, bool ok) { outcomes.emplace_back(t, ok); }, [](double) {});
+  GnssAttacher gnss(options_.gnss, [&](double t, bool ok) { outcomes.emplace_back(t, ok); }, [](double) {});
   // 10 cm off: innovation χ² ≈ 0.1²/(0.05² + 0.02²) ≈ 3.4: accepted, at full weight.
   EXPECT_TRUE(gnss.OnGnss(Fix(10.0, Vec3(100.1, 0.0, 0.0)), context_));
   EXPECT_EQ(Residuals(), 1);
@@ -124,7 +124,7 @@ TEST_F(AttacherTest, AgreeingRejectedFixesReacquire) {
   Push(0.0, 10.0);
   sigma_p_ = 0.02;
   std::vector<double> reacquired;
-  GnssAttacher gnss(options_, [](double, bool) {}, [&](double f) { reacquired.push_back(f); });
+  GnssAttacher gnss(options_.gnss, [](double, bool) {}, [&](double f) { reacquired.push_back(f); });
   // The estimate is 0.5 m off (an overconfident window after an outage): every fix agrees with the next.
   int accepted_at = -1;
   for (int k = 0; k < 10 && accepted_at < 0; ++k) {
@@ -140,7 +140,7 @@ TEST_F(AttacherTest, AgreeingRejectedFixesReacquire) {
 TEST_F(AttacherTest, ScatteredOutliersDoNotReacquire) {
   Push(0.0, 10.0);
   sigma_p_ = 0.02;
-  GnssAttacher gnss(options_, [](double, bool) {}, [](double) {});
+  GnssAttacher gnss(options_.gnss, [](double, bool) {}, [](double) {});
   // 20 m outliers in directions that change every time: never a run that agrees.
   for (int k = 0; k < 12; ++k) {
     const double a = 2.1 * k;
@@ -152,7 +152,7 @@ TEST_F(AttacherTest, ScatteredOutliersDoNotReacquire) {
 
 TEST_F(AttacherTest, StandstillIsCheckedAgainstThePredictedVelocity) {
   options_.standstill.max_speed = 0.5;
-  StandstillAttacher standstill(options_);
+  StandstillAttacher standstill(options_.standstill, options_.imu, options_.wheel.gate_probability);
   Keyframe& a = Push(20.0, 0.01);
   standstill.OnStandstill({20.0, 18.0}, context_);
   EXPECT_EQ(Residuals(), 1);  // the zero velocity
@@ -180,7 +180,7 @@ TEST_F(AttacherTest, StandstillIsCheckedAgainstThePredictedVelocity) {
 // 0.5 s (0.04 deg/s) allow far less. The zero motion joins the keyframes with its rotation free, and the
 // outputs between them are not held still.
 TEST_F(AttacherTest, StandingButTurningKeepsTheRotationFree) {
-  StandstillAttacher standstill(options_);
+  StandstillAttacher standstill(options_.standstill, options_.imu, options_.wheel.gate_probability);
   Push(20.0, 0.0);
   standstill.OnStandstill({20.0, 18.0}, context_);
   Keyframe& b = Push(20.5, 0.0);

@@ -211,7 +211,7 @@ int RunCli(int argc, const char* const* argv, bool own_process) {
       std::printf("gins simulate: %.1f s, %llu IMU, %llu GNSS, %llu GVEL, %llu ODOM records -> %s/log.txt, "
                   "%s/truth.csv\n",
                   r.duration, static_cast<unsigned long long>(r.imu), static_cast<unsigned long long>(r.gnss),
-                  static_cast<unsigned long long>(r.gvel), static_cast<unsigned long long>(r.odom), sim_out.c_str(),
+                  static_cast<unsigned long long>(r.gnss_velocity), static_cast<unsigned long long>(r.wheel), sim_out.c_str(),
                   sim_out.c_str());
       return 0;
     }

@@ -99,7 +99,7 @@ nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nloh
                          const api::Status& status) {
   nlohmann::json input;
   input["lines"] = rs.lines;
-  input["records"] = {{"imu", rs.imu}, {"odom", rs.odom}, {"gnss", rs.gnss}, {"gvel", rs.gvel}};
+  input["records"] = {{"imu", rs.imu}, {"odom", rs.wheel}, {"gnss", rs.gnss}, {"gvel", rs.gnss_velocity}};
   input["skipped"] = nlohmann::json::object();
   for (const auto& [k, v] : rs.skipped) input["skipped"][k] = v;
   input["skipped_examples"] = nlohmann::json::array();
@@ -270,9 +270,9 @@ void CheckReadCounts(const std::string& name, const ReadStats& rs) {
   auto no_usable = [&](const std::string& what) {
     if (rs.lines == 0) return RunError(name + ": empty log (no lines)");
     std::string m = name + ": no usable " + what + " records (" + std::to_string(rs.lines) + " lines: " +
-                    std::to_string(rs.imu) + " IMU, " + std::to_string(rs.odom) + " ODOM, " +
+                    std::to_string(rs.imu) + " IMU, " + std::to_string(rs.wheel) + " ODOM, " +
                     std::to_string(rs.gnss) + " GNSS, " +
-                    (rs.gvel > 0 ? std::to_string(rs.gvel) + " GVEL, " : std::string()) +
+                    (rs.gnss_velocity > 0 ? std::to_string(rs.gnss_velocity) + " GVEL, " : std::string()) +
                     std::to_string(rs.total_skipped()) + " damaged";
     if (!rs.examples.empty()) {
       m += "; first: line " + std::to_string(rs.examples.front().line) + ": " + rs.examples.front().reason + ": " +

@@ -33,7 +33,7 @@ constexpr double kMaxInflation = 100.0;
 
 // The preintegrated IMU from t0 to every measurement epoch.
 struct Snapshots {
-  std::vector<PreintSnapshot> fix, gvel, wheel;
+  std::vector<PreintSnapshot> fix, gnss_velocity, wheel;
   std::vector<Vec3> fix_omega_b, gvel_omega_b;  // gyro less bias at each fix's and GNSS velocity's epoch
   std::unique_ptr<Preintegration> total;  // to the last epoch
 };
@@ -44,19 +44,19 @@ double WheelEpoch(const WheelMeasurement& w) { return w.t - 0.5 * w.interval; }
 Snapshots Integrate(const AlignmentInput& in, const Vec3& bg, const Vec3& ba, const ImuOptions& imu) {
   struct Request {
     double t;
-    int kind;  // 0 fix, 1 gvel, 2 wheel
+    int kind;  // 0 fix, 1 gnss_velocity, 2 wheel
     size_t index;
   };
   std::vector<Request> req;
   for (size_t i = 0; i < in.fixes.size(); ++i) req.push_back({in.fixes[i].t, 0, i});
-  for (size_t i = 0; i < in.gvels.size(); ++i) req.push_back({in.gvels[i].t, 1, i});
+  for (size_t i = 0; i < in.gnss_velocities.size(); ++i) req.push_back({in.gnss_velocities[i].t, 1, i});
   for (size_t i = 0; i < in.wheels.size(); ++i) req.push_back({WheelEpoch(in.wheels[i]), 2, i});
   std::stable_sort(req.begin(), req.end(), [](const Request& a, const Request& b) { return a.t < b.t; });
   Snapshots s;
   s.fix.resize(in.fixes.size());
-  s.gvel.resize(in.gvels.size());
+  s.gnss_velocity.resize(in.gnss_velocities.size());
   s.fix_omega_b.resize(in.fixes.size(), Vec3::Zero());
-  s.gvel_omega_b.resize(in.gvels.size(), Vec3::Zero());
+  s.gvel_omega_b.resize(in.gnss_velocities.size(), Vec3::Zero());
   s.wheel.resize(in.wheels.size());
   s.total = std::make_unique<Preintegration>(bg, ba, imu.gyro_noise_density, imu.acc_noise_density);
   Preintegration& pre = *s.total;
@@ -73,7 +73,7 @@ Snapshots Integrate(const AlignmentInput& in, const Vec3& bg, const Vec3& ba, co
       s.fix_omega_b[q.index] = held.gyro - bg;
     }
     if (q.kind == 1) {
-      s.gvel[q.index] = snap;
+      s.gnss_velocity[q.index] = snap;
       s.gvel_omega_b[q.index] = held.gyro - bg;
     }
     if (q.kind == 2) s.wheel[q.index] = snap;
@@ -130,12 +130,12 @@ void BuildProblem(const FitContext& c, const Snapshots& s, const Quat& q_ref, do
       Add<2>(p, align::NhcTerm{epoch, s.fix_omega_b[i], so.wheel.lever_b, 1.0 / so.vehicle.nhc_sigma}, x, true);
     }
   }
-  for (size_t i = 0; i < in.gvels.size(); ++i) {
-    const GvelMeasurement& m = in.gvels[i];
-    const double imu_var = IsotropicVariance(s.gvel[i].cov().block<3, 3>(preint::kV, preint::kV));
+  for (size_t i = 0; i < in.gnss_velocities.size(); ++i) {
+    const GnssVelocityMeasurement& m = in.gnss_velocities[i];
+    const double imu_var = IsotropicVariance(s.gnss_velocity[i].cov().block<3, 3>(preint::kV, preint::kV));
     const Vec3 sigma = (m.sigma_w.cwiseAbs2() + Vec3::Constant(imu_var)).cwiseSqrt();
     Add<3>(p,
-           align::GvelTerm{align::Epoch(s.gvel[i], c.earth, q_ref), s.gvel_omega_b[i], so.gnss.lever_b, m.v_w,
+           align::GvelTerm{align::Epoch(s.gnss_velocity[i], c.earth, q_ref), s.gvel_omega_b[i], so.gnss.lever_b, m.v_w,
                            sigma.cwiseInverse()},
            x, true);
   }
@@ -258,9 +258,9 @@ double AngleBetween(double a, double b) { return std::abs(WrapAngle(a - b)); }
 double Course(const AlignmentInput& in) {
   Vec2 d = Vec2::Zero();
   if (in.fixes.size() >= 2) d = (in.fixes.back().p_w - in.fixes.front().p_w).head<2>();
-  if (d.norm() < 3.0 * in.fixes.back().sigma_w.head<2>().norm() && !in.gvels.empty()) {
+  if (d.norm() < 3.0 * in.fixes.back().sigma_w.head<2>().norm() && !in.gnss_velocities.empty()) {
     d.setZero();
-    for (const GvelMeasurement& g : in.gvels) d += g.v_w.head<2>();
+    for (const GnssVelocityMeasurement& g : in.gnss_velocities) d += g.v_w.head<2>();
   }
   return d.norm() > 0.0 ? std::atan2(d.y(), d.x()) : 0.0;
 }
@@ -268,7 +268,7 @@ double Course(const AlignmentInput& in) {
 // Velocity at t0 from the first fixes (zero after a standstill).
 Vec3 FirstVelocity(const AlignmentInput& in) {
   if (in.standstill) return Vec3::Zero();
-  if (!in.gvels.empty() && in.gvels.front().t - in.imu.front().t < 1.0) return in.gvels.front().v_w;
+  if (!in.gnss_velocities.empty() && in.gnss_velocities.front().t - in.imu.front().t < 1.0) return in.gnss_velocities.front().v_w;
   const double t0 = in.imu.front().t;
   const GnssMeasurement* a = nullptr;
   const GnssMeasurement* b = nullptr;

@@ -39,7 +39,7 @@ struct AlignmentInput {
   std::vector<ImuSample> imu;  // body axes, time order; imu.front().t is t0
   // Measurements with t in [t0, imu.back().t] (GNSS fixes also from the standstill before t0, if any).
   std::vector<GnssMeasurement> fixes;
-  std::vector<GvelMeasurement> gvels;
+  std::vector<GnssVelocityMeasurement> gnss_velocities;
   std::vector<WheelMeasurement> wheels;
   std::optional<StaticSummary> standstill;  // the vehicle stood still until t0
 };

@@ -8,7 +8,7 @@
 
 #include "core/conventions.h"
 #include "core/gnss_model.h"
-#include "core/gvel_model.h"
+#include "core/gnss_velocity_model.h"
 #include "core/heading_model.h"
 #include "core/nav_state.h"
 #include "core/preintegration.h"
@@ -102,7 +102,7 @@ struct GnssTerm {
   }
 };
 
-// GNSS (Doppler) antenna velocity (core/gvel_model.h): 3 residuals. omega_b: body rate at the epoch.
+// GNSS (Doppler) antenna velocity (core/gnss_velocity_model.h): 3 residuals. omega_b: body rate at the epoch.
 struct GvelTerm {
   Epoch epoch;
   Vec3 omega_b, lever_b, z_w, inv_sigma;

@@ -100,17 +100,17 @@ void Initializer::AddWheel(const WheelMeasurement& wheel) {
   detector_.AddWheel(wheel);
 }
 
-void Initializer::AddGvel(const GvelMeasurement& gvel) {
+void Initializer::AddGnssVelocity(const GnssVelocityMeasurement& gnss_velocity) {
   if (done()) return;
-  gvels_.push_back(gvel);
-  detector_.AddGvel(gvel);
+  gnss_velocities_.push_back(gnss_velocity);
+  detector_.AddGnssVelocity(gnss_velocity);
 }
 
 void Initializer::Prune(double t) {
   const double keep = kMaxWindow + 1.0;
   while (!imu_.empty() && t - imu_.front().t > keep) imu_.pop_front();
   while (!fixes_.empty() && t - fixes_.front().t > keep) fixes_.pop_front();
-  while (!gvels_.empty() && t - gvels_.front().t > keep) gvels_.pop_front();
+  while (!gnss_velocities_.empty() && t - gnss_velocities_.front().t > keep) gnss_velocities_.pop_front();
   while (!wheels_.empty() && t - wheels_.front().t > keep) wheels_.pop_front();
 }
 
@@ -224,7 +224,7 @@ bool Initializer::Moved(const AlignmentInput& in) const {
   // Yaw needs motion: a speed that the GNSS velocities or a line through the fixes show to be non-zero
   // (a slow rover on metre-level fixes needs a few seconds; a track longer than the fixes' σ, far more).
   const double t0 = in.imu.front().t;
-  if (const std::optional<GnssSpeed> v = MeanGnssVelocity(in.gvels, t0)) {
+  if (const std::optional<GnssSpeed> v = MeanGnssVelocity(in.gnss_velocities, t0)) {
     if (GnssShowsMotion(*v, kMotionProbability)) return true;
   }
   const std::optional<GnssSpeed> line = LineThroughFixes(in.fixes, t0);
@@ -259,7 +259,7 @@ bool Initializer::BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bo
   *full = fix.t - t0 >= length - kAttemptInterval;
   const auto at = [](const auto& m) { return m.t; };
   AppendThinned(fixes_, t0, fix.t, at, &in->fixes);
-  AppendThinned(gvels_, t0, fix.t, at, &in->gvels);
+  AppendThinned(gnss_velocities_, t0, fix.t, at, &in->gnss_velocities);
   AppendThinned(wheels_, t0, fix.t, [](const WheelMeasurement& w) { return w.t - 0.5 * w.interval; }, &in->wheels);
   if (in->fixes.size() < 3) {
     last_problem_ = "waiting for more GNSS fixes";

@@ -103,7 +103,7 @@ class Initializer {
   void AddImu(const ImuSample& imu);
   void AddWheel(const WheelMeasurement& wheel);
   void AddGnss(const GnssMeasurement& gnss);
-  void AddGvel(const GvelMeasurement& gvel);
+  void AddGnssVelocity(const GnssVelocityMeasurement& gnss_velocity);
 
   bool done() const { return result_.has_value(); }
   const InitResult& result() const { return *result_; }
@@ -143,7 +143,7 @@ class Initializer {
   StandstillDetector detector_;
   std::deque<ImuSample> imu_;  // since the last IMU gap, at most the longest window
   std::deque<GnssMeasurement> fixes_;
-  std::deque<GvelMeasurement> gvels_;
+  std::deque<GnssVelocityMeasurement> gnss_velocities_;
   std::deque<WheelMeasurement> wheels_;
   double first_time_ = -1.0;
   std::optional<Standstill> standing_;  // the current standstill

@@ -16,7 +16,7 @@ struct ImuSample {
 };
 
 // Wheel encoder pulses counted over (t − Δt, t].
-struct OdomRecord {
+struct WheelRecord {
   double t = 0.0;
   double left_pulses = 0.0;
   double right_pulses = 0.0;
@@ -36,7 +36,7 @@ struct GnssRecord {
 
 // GNSS (Doppler) velocity as logged (GVEL records): the antenna's velocity in the local East-North-Up frame
 // at the fix, with an optional 1-σ per axis.
-struct GvelRecord {
+struct GnssVelocityRecord {
   double t = 0.0;
   Vec3 v_enu = Vec3::Zero();     // m/s
   bool has_sigma = false;
@@ -44,7 +44,7 @@ struct GvelRecord {
 };
 
 // A GNSS velocity in the world frame, ready for an estimator.
-struct GvelMeasurement {
+struct GnssVelocityMeasurement {
   double t = 0.0;
   Vec3 v_w = Vec3::Zero();        // antenna velocity in w, m/s
   Vec3 sigma_w = Vec3::Ones();    // 1-σ per ENU axis, m/s

@@ -70,7 +70,7 @@ void StandstillDetector::AddImu(const ImuSample& imu) {
   const double keep = std::max(options_.window, 2.0 * wheel_interval_);
   while (!wheels_.empty() && t_ - wheels_.front().t > keep) wheels_.pop_front();
   while (!fixes_.empty() && t_ - fixes_.front().t > kMaxGnssSpan) fixes_.pop_front();
-  while (!gvels_.empty() && t_ - gvels_.front().t > kMaxGnssSpan) gvels_.pop_front();
+  while (!gnss_velocities_.empty() && t_ - gnss_velocities_.front().t > kMaxGnssSpan) gnss_velocities_.pop_front();
   if (!WindowQuiet()) {
     quiet_since_ = -1.0;
   } else if (quiet_since_ < 0.0) {
@@ -80,7 +80,7 @@ void StandstillDetector::AddImu(const ImuSample& imu) {
 
 void StandstillDetector::AddWheel(const WheelMeasurement& wheel) { wheels_.push_back(wheel); }
 void StandstillDetector::AddGnss(const GnssMeasurement& fix) { fixes_.push_back(fix); }
-void StandstillDetector::AddGvel(const GvelMeasurement& vel) { gvels_.push_back(vel); }
+void StandstillDetector::AddGnssVelocity(const GnssVelocityMeasurement& vel) { gnss_velocities_.push_back(vel); }
 
 StandstillDetector::CumulativeSums StandstillDetector::Deviations(const ImuSample& s) const {
   return {s.gyro - ref_g_, s.acc - ref_a_};
@@ -138,7 +138,7 @@ bool StandstillDetector::WheelsPresent() const { return !wheels_.empty(); }
 
 StandstillDetector::State StandstillDetector::GnssVerdict(Witness* witness) const {
   // GNSS velocity: the mean over the quiet stretch against zero.
-  if (const std::optional<GnssSpeed> v = MeanGnssVelocity(gvels_, quiet_since_)) {
+  if (const std::optional<GnssSpeed> v = MeanGnssVelocity(gnss_velocities_, quiet_since_)) {
     *witness = Witness::kGnssVelocity;
     return SpeedVerdict(*v, options_.max_speed);
   }

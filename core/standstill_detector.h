@@ -52,7 +52,7 @@ class StandstillDetector {
   void AddImu(const ImuSample& imu);
   void AddWheel(const WheelMeasurement& wheel);
   void AddGnss(const GnssMeasurement& fix);
-  void AddGvel(const GvelMeasurement& vel);
+  void AddGnssVelocity(const GnssVelocityMeasurement& vel);
 
   // At the newest IMU sample.
   State Decide() const;
@@ -94,7 +94,7 @@ class StandstillDetector {
   size_t removed_ = 0;                              // samples removed since the last rebase
   std::deque<WheelMeasurement> wheels_;
   std::deque<GnssMeasurement> fixes_;
-  std::deque<GvelMeasurement> gvels_;
+  std::deque<GnssVelocityMeasurement> gnss_velocities_;
   double t_ = 0.0;             // newest IMU time
   double quiet_since_ = -1.0;  // start of the quiet stretch
 };
@@ -109,11 +109,11 @@ struct GnssSpeed {
 
 // The mean of the GNSS velocities from t_from on (nullopt: none).
 template <typename Gvels>
-std::optional<GnssSpeed> MeanGnssVelocity(const Gvels& gvels, double t_from) {
+std::optional<GnssSpeed> MeanGnssVelocity(const Gvels& gnss_velocities, double t_from) {
   Vec2 sum = Vec2::Zero();
   double var = 0.0;
   int n = 0;
-  for (const GvelMeasurement& g : gvels) {
+  for (const GnssVelocityMeasurement& g : gnss_velocities) {
     if (g.t < t_from) continue;
     sum += g.v_w.template head<2>();
     var += g.sigma_w.template head<2>().squaredNorm() / 2.0;

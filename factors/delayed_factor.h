@@ -7,7 +7,7 @@
 //   DelayedAttachedCostFunction<M> the stamp between keyframe i and the next: the state at t from the IMU
 //                                  preintegrated from t_i (PreintAttachedCostFunction's prediction and
 //                                  analytic Jacobians). Blocks: pose_i (7), vel_i (3), bias_i (6), td_i (1).
-// Residual: M's (GnssAtTime, HeadingAtTime, GvelAtTime: factors/preint_attached_factor.h), whitened by it.
+// Residual: M's (GnssAtTime, HeadingAtTime, GnssVelocityAtTime: factors/preint_attached_factor.h), whitened by it.
 // td in s, beyond the stated gnss.time_offset_s (the session re-stamps the records by that).
 #pragma once
 

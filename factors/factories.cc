@@ -14,7 +14,7 @@
 #include "factors/delayed_factor.h"
 #include "factors/gnss_factor.h"
 #include "factors/gnss_preint_factor.h"
-#include "factors/gvel_factor.h"
+#include "factors/gnss_velocity_factor.h"
 #include "factors/odometer_factor.h"
 #include "factors/preint_attached_factor.h"
 #include "factors/wheel_yaw_factor.h"
@@ -68,7 +68,7 @@ ceres::CostFunction* PreintAttachedFactor<Measurement>::CreateAutoDiff(std::shar
 }
 template class PreintAttachedFactor<GnssAtTime>;
 template class PreintAttachedFactor<HeadingAtTime>;
-template class PreintAttachedFactor<GvelAtTime>;
+template class PreintAttachedFactor<GnssVelocityAtTime>;
 
 template <class Measurement>
 ceres::CostFunction* DelayedAtKeyframeFactor<Measurement>::Create(Delayed<Measurement> delayed) {
@@ -82,7 +82,7 @@ ceres::CostFunction* DelayedAtKeyframeFactor<Measurement>::CreateAutoDiff(Delaye
 }
 template class DelayedAtKeyframeFactor<GnssAtTime>;
 template class DelayedAtKeyframeFactor<HeadingAtTime>;
-template class DelayedAtKeyframeFactor<GvelAtTime>;
+template class DelayedAtKeyframeFactor<GnssVelocityAtTime>;
 
 ceres::CostFunction* GnssPreintFactor::Create(std::shared_ptr<const Preintegration> preint,
                                               const ImuEarthTerms& earth, const Vec3& z_w, const Vec3& sigma_w,
@@ -92,11 +92,11 @@ ceres::CostFunction* GnssPreintFactor::Create(std::shared_ptr<const Preintegrati
                                                   GnssAtTime{z_w, sigma_w.cwiseInverse(), lever_b});
 }
 
-ceres::CostFunction* GvelFactor::Create(const Vec3& z_w, const Vec3& sigma_w, const Vec3& omega_b,
+ceres::CostFunction* GnssVelocityFactor::Create(const Vec3& z_w, const Vec3& sigma_w, const Vec3& omega_b,
                                         const Vec3& lever_b) {
   CHECK((sigma_w.array() > 0.0).all()) << "GvelFactor: σ must be > 0, got " << sigma_w.transpose();
-  return new ceres::AutoDiffCostFunction<GvelFactor, 3, pose::kAmbient, 3>(
-      new GvelFactor(z_w, sigma_w, omega_b, lever_b));
+  return new ceres::AutoDiffCostFunction<GnssVelocityFactor, 3, pose::kAmbient, 3>(
+      new GnssVelocityFactor(z_w, sigma_w, omega_b, lever_b));
 }
 
 ceres::CostFunction* OdometerFactor::CreateAutoDiff(const Vec3& displacement_i, double sigma, const Vec3& lever_b) {

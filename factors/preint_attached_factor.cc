@@ -180,12 +180,12 @@ ceres::CostFunction* DelayedAttachedCostFunction<Measurement>::CreateAutoDiff(
 
 template class PreintAttachedCostFunction<GnssAtTime>;
 template class PreintAttachedCostFunction<HeadingAtTime>;
-template class PreintAttachedCostFunction<GvelAtTime>;
+template class PreintAttachedCostFunction<GnssVelocityAtTime>;
 template class DelayedAttachedCostFunction<GnssAtTime>;
 template class DelayedAttachedCostFunction<HeadingAtTime>;
-template class DelayedAttachedCostFunction<GvelAtTime>;
+template class DelayedAttachedCostFunction<GnssVelocityAtTime>;
 template class DelayedAtKeyframeCostFunction<GnssAtTime>;
 template class DelayedAtKeyframeCostFunction<HeadingAtTime>;
-template class DelayedAtKeyframeCostFunction<GvelAtTime>;
+template class DelayedAtKeyframeCostFunction<GnssVelocityAtTime>;
 
 }  // namespace gins

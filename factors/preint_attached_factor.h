@@ -7,7 +7,7 @@
 // Residual: the model's, whitened by it. Models (each delegates to its core model):
 //   GnssAtTime     r = (p_t + R_t·lever_b − z_w) ./ σ_w                     (3, core/gnss_model.h)
 //   HeadingAtTime  r = wrap(yaw(R_t·Rz(mount)) − yaw_meas) / σ              (1, core/heading_model.h)
-//   GvelAtTime     r = (v_t + R_t·(ω_b × lever_b) − z_w) ./ σ_w             (3, core/gvel_model.h)
+//   GnssVelocityAtTime     r = (v_t + R_t·(ω_b × lever_b) − z_w) ./ σ_w             (3, core/gnss_velocity_model.h)
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -19,7 +19,7 @@
 
 #include "core/conventions.h"
 #include "core/gnss_model.h"
-#include "core/gvel_model.h"
+#include "core/gnss_velocity_model.h"
 #include "core/heading_model.h"
 #include "core/preintegration.h"
 #include "core/so3.h"
@@ -66,7 +66,7 @@ struct HeadingAtTime {
   }
 };
 
-struct GvelAtTime {
+struct GnssVelocityAtTime {
   static constexpr int kResidualDim = GnssVelocityModel::kResidualDim;
   Vec3 z_w, inv_sigma, omega_b, lever_b;
   template <typename T>

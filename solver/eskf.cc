@@ -6,7 +6,7 @@
 
 #include "core/chi2.h"
 #include "core/gnss_model.h"
-#include "core/gvel_model.h"
+#include "core/gnss_velocity_model.h"
 #include "core/heading_model.h"
 #include "core/imu_kernel.h"
 #include "core/linearize.h"
@@ -393,7 +393,7 @@ nlohmann::json Eskf::Stats() const {
   j[summary_keys::kWatchdog] = watchdog_.ToJson();
   j["gnss_position"] = gnss_counts_.ToJson();
   j["gnss_heading"] = heading_counts_.ToJson();
-  j["gnss_velocity"] = gvel_counts_.ToJson();
+  j["gnss_velocity"] = gnss_velocity_counts_.ToJson();
   j["wheel"] = wheel_counts_.ToJson();
   j["wheel_yaw_rate"] = wheel_yaw_counts_.ToJson();
   j["nonholonomic"] = nhc_counts_.ToJson();

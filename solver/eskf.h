@@ -59,7 +59,7 @@ class Eskf : public Estimator {
   void Initialize(const InitResult& init) override;
   void AddImu(const ImuSample& imu) override;
   void AddGnss(const GnssMeasurement& gnss) override;
-  void AddGvel(const GvelMeasurement& gvel) override;
+  void AddGnssVelocity(const GnssVelocityMeasurement& gnss_velocity) override;
   void AddWheel(const WheelMeasurement& wheel) override;
   void AddStandstill(const StandstillMeasurement& m) override;
   void AddRestState(const StateEstimate& s) override;
@@ -167,7 +167,7 @@ class Eskf : public Estimator {
          gate_zupt_ = 0.0, gate_zero_rate_ = 0.0;
   uint64_t imu_steps_ = 0;
   ImuGapLog imu_gaps_;
-  MeasurementCounts gnss_counts_, heading_counts_, gvel_counts_, wheel_counts_, wheel_yaw_counts_, nhc_counts_,
+  MeasurementCounts gnss_counts_, heading_counts_, gnss_velocity_counts_, wheel_counts_, wheel_yaw_counts_, nhc_counts_,
       zupt_counts_;
 
   GnssWatchdog watchdog_;

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "core/gnss_model.h"
-#include "core/gvel_model.h"
+#include "core/gnss_velocity_model.h"
 #include "core/heading_model.h"
 #include "core/linearize.h"
 #include "core/so3.h"
@@ -115,7 +115,7 @@ void Eskf::UpdateHeading(const GnssMeasurement& m) {
   Update<1>(model, Eigen::Matrix<double, 1, 1>(m.sigma_yaw * m.sigma_yaw), gate_heading_, &heading_counts_, m.t);
 }
 
-void Eskf::AddGvel(const GvelMeasurement& m) {
+void Eskf::AddGnssVelocity(const GnssVelocityMeasurement& m) {
   if (!initialized_ || m.t < nom_.x.t) return;
   Propagate(m.t);
   // The antenna's velocity includes the lever arm's turn: the body rate from the last IMU sample.
@@ -137,7 +137,7 @@ void Eskf::AddGvel(const GvelMeasurement& m) {
                                               {Block::kTheta, H.middleCols<3>(3)},
                                               {Block::kTd, H.rightCols<1>()}})};
   };
-  Update<3>(model, Mat3(m.sigma_w.cwiseAbs2().asDiagonal()), gate_gnss_, &gvel_counts_, m.t);
+  Update<3>(model, Mat3(m.sigma_w.cwiseAbs2().asDiagonal()), gate_gnss_, &gnss_velocity_counts_, m.t);
 }
 
 void Eskf::AddWheel(const WheelMeasurement& m) {

@@ -34,7 +34,7 @@ class Estimator {
   virtual void AddImu(const ImuSample& imu) = 0;
   virtual void AddGnss(const GnssMeasurement& gnss) = 0;
   // A GNSS velocity, after the fix of the same epoch (if any).
-  virtual void AddGvel(const GvelMeasurement& gvel) = 0;
+  virtual void AddGnssVelocity(const GnssVelocityMeasurement& gnss_velocity) = 0;
   virtual void AddWheel(const WheelMeasurement& wheel) = 0;
   // The vehicle stands (the session's detector: wheels at zero and IMU quiet, or IMU quiet without
   // wheels); sent at most every 0.1 s while it stands, right after the IMU sample at m.t.

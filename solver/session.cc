@@ -283,7 +283,7 @@ void Session::DetectStandstill(double t) {
   Dispatch(&Estimator::AddStandstill, m);
 }
 
-void Session::AddOdom(const OdomRecord& o) {
+void Session::AddWheel(const WheelRecord& o) {
   Touch(o.t);
   if (!options_.wheel.enabled) {
     ++odom_ignored_;
@@ -305,14 +305,14 @@ void Session::AddOdom(const OdomRecord& o) {
   }
 }
 
-WheelMeasurement Session::WheelFromOdom(const OdomRecord& o) {
+WheelMeasurement Session::WheelFromOdom(const WheelRecord& o) {
   const WheelOptions& wo = options_.wheel;
   // The pulses were counted since the previous record: its spacing is the interval, within half the
   // nominal one either way (clock jitter, counted); a longer spacing means records were lost, and the
   // record's own count then covers the nominal interval only (a gap, counted).
   double interval = wo.interval;
-  if (last_odom_t_) {
-    const double spacing = o.t - *last_odom_t_;
+  if (last_wheel_t_) {
+    const double spacing = o.t - *last_wheel_t_;
     if (spacing > 0.5 * wo.interval && spacing < 1.5 * wo.interval) {
       interval = spacing;
       if (std::abs(spacing - wo.interval) > 0.1 * wo.interval) ++wheel_jitter_;
@@ -320,7 +320,7 @@ WheelMeasurement Session::WheelFromOdom(const OdomRecord& o) {
       ++wheel_gaps_;
     }
   }
-  last_odom_t_ = o.t;
+  last_wheel_t_ = o.t;
   WheelMeasurement w;
   w.t = o.t;
   const double left = WheelSpeedFromPulses(o.left_pulses, wo.radius, wo.pulses_per_rev, interval);
@@ -385,23 +385,23 @@ void Session::AddGnss(const GnssRecord& g) {
   }
 }
 
-void Session::AddGvel(const GvelRecord& g) {
+void Session::AddGnssVelocity(const GnssVelocityRecord& g) {
   Touch(g.t);
   const bool in_outage = initialized_ && !outage_schedule_.empty() && outage_schedule_.Contains(g.t, first_t_);
   if (!options_.gnss.use_velocity || !last_fix_geo_ || !init_ || in_outage) {
     ++gvel_unused_;
     return;
   }
-  GvelMeasurement m;
+  GnssVelocityMeasurement m;
   m.t = g.t;
   m.v_w = frame_->RotationFromLocalEnu(*last_fix_geo_) * g.v_enu;
   m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options_.gnss.min_velocity_sigma) : options_.gnss.velocity_sigma_enu;
-  if (standstill_) standstill_->AddGvel(m);
+  if (standstill_) standstill_->AddGnssVelocity(m);
   if (!initialized_) {
-    init_->AddGvel(m);
+    init_->AddGnssVelocity(m);
     return;
   }
-  Dispatch(&Estimator::AddGvel, m);
+  Dispatch(&Estimator::AddGnssVelocity, m);
 }
 
 // --- Simulated GNSS outages ---------------------------------------------------------------------------------

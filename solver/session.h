@@ -49,9 +49,9 @@ class Session {
   void CancelThreads();
 
   void AddImu(const ImuSample& raw);
-  void AddOdom(const OdomRecord& odom);
+  void AddWheel(const WheelRecord& wheel);
   void AddGnss(const GnssRecord& fix);
-  void AddGvel(const GvelRecord& vel);
+  void AddGnssVelocity(const GnssVelocityRecord& vel);
   // A log's record (or a simulated one) to the Add* of its type: the one dispatch before the estimators.
   void Add(const LogRecord& r);
   // End of the data: flushes the estimators. Throws RunError if initialisation never completed.
@@ -104,8 +104,8 @@ class Session {
   std::optional<double> last_fix_t_;  // the previous fix's time (gnss.error_correlation_s)
   uint64_t gvel_unused_ = 0;
   // Wheel records: the previous one's time (its spacing is the counting interval), jitter and gaps.
-  WheelMeasurement WheelFromOdom(const OdomRecord& o);
-  std::optional<double> last_odom_t_;
+  WheelMeasurement WheelFromOdom(const WheelRecord& o);
+  std::optional<double> last_wheel_t_;
   uint64_t wheel_jitter_ = 0, wheel_gaps_ = 0;
   double first_t_ = -1.0, last_t_ = 0.0;
   // IMU sample spacing, for the summary (the estimators integrate each interval as stamped, and count the
@@ -155,12 +155,12 @@ inline void Session::Add(const LogRecord& r) {
   switch (r.type) {
     case LogRecord::Type::kImu:
       return AddImu(r.imu);
-    case LogRecord::Type::kOdom:
-      return AddOdom(r.odom);
+    case LogRecord::Type::kWheel:
+      return AddWheel(r.wheel);
     case LogRecord::Type::kGnss:
       return AddGnss(r.gnss);
-    case LogRecord::Type::kGvel:
-      return AddGvel(r.gvel);
+    case LogRecord::Type::kGnssVelocity:
+      return AddGnssVelocity(r.gnss_velocity);
   }
 }
 

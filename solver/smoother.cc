@@ -45,7 +45,7 @@ Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, Stat
   attachers_.push_back(std::make_unique<VehicleAttacher>(options_));
   attachers_.push_back(
       std::make_unique<StandstillAttacher>(options_.standstill, options_.imu, options_.wheel.gate_probability));
-  attachers_.push_back(std::make_unique<GvelAttacher>(options_.gnss));
+  attachers_.push_back(std::make_unique<GnssVelocityAttacher>(options_.gnss));
   attachers_.push_back(std::make_unique<GnssAttacher>(
       options_.gnss, [this](double t, bool accepted) { WatchGnss(t, accepted); },
       [this](double factor) { RelievePrior(factor); }));
@@ -267,11 +267,11 @@ void Smoother::AddStandstill(const StandstillMeasurement& m) {
   for (auto& attacher : attachers_) attacher->OnStandstill(m, context_);
 }
 
-void Smoother::AddGvel(const GvelMeasurement& m) {
+void Smoother::AddGnssVelocity(const GnssVelocityMeasurement& m) {
   if (!initialized_ || m.t < t_now_ - kSameEpoch || m.t < window_.back().t - kSameEpoch) return;
   if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
   bool attached = false;
-  for (auto& attacher : attachers_) attached = attacher->OnGvel(m, context_) || attached;
+  for (auto& attacher : attachers_) attached = attacher->OnGnssVelocity(m, context_) || attached;
   if (attached) solve_pending_ = true;
 }
 

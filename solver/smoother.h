@@ -58,7 +58,7 @@ class Smoother : public Estimator {
   void Initialize(const InitResult& init) override;
   void AddImu(const ImuSample& imu) override;
   void AddGnss(const GnssMeasurement& gnss) override;
-  void AddGvel(const GvelMeasurement& gvel) override;
+  void AddGnssVelocity(const GnssVelocityMeasurement& gnss_velocity) override;
   void AddWheel(const WheelMeasurement& wheel) override;
   void AddStandstill(const StandstillMeasurement& m) override;
   void AddRestState(const StateEstimate& s) override;

@@ -9,7 +9,7 @@
 #include "core/chi2.h"
 #include "factors/delayed_factor.h"
 #include "factors/gnss_factor.h"
-#include "factors/gvel_factor.h"
+#include "factors/gnss_velocity_factor.h"
 #include "factors/heading_factor.h"
 #include "factors/preint_attached_factor.h"
 #include "factors/zero_motion_factor.h"
@@ -237,20 +237,20 @@ void GnssAttacher::AddStats(nlohmann::json* stats) const {
 
 // --- GNSS velocity ----------------------------------------------------------------------------------------
 
-GvelAttacher::GvelAttacher(const GnssOptions& gnss)
+GnssVelocityAttacher::GnssVelocityAttacher(const GnssOptions& gnss)
     : lever_b_(gnss.lever_b),
       gate_(Chi2Gate(gnss.gate_probability, 3)),
       loss_(std::isfinite(gate_) ? new ceres::HuberLoss(std::sqrt(gate_)) : nullptr) {}
 
-bool GvelAttacher::OnGvel(const GvelMeasurement& m, const AttachContext& ctx) {
+bool GnssVelocityAttacher::OnGnssVelocity(const GnssVelocityMeasurement& m, const AttachContext& ctx) {
   const Prediction pred = ctx.predict(m.t);
   const StateBlocks at(pred.x, ctx.keyframes);
   const Vec3 omega_b = ctx.BodyRate(pred.x);
-  const GvelAtTime model{m.v_w, m.sigma_w.cwiseInverse(), omega_b, lever_b_};
+  const GnssVelocityAtTime model{m.v_w, m.sigma_w.cwiseInverse(), omega_b, lever_b_};
   const GateCheck gate =
       TimeOffsetEstimated(ctx)
           ? DelayedCheck(model, pred, at, ctx)
-          : StampCheck(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, lever_b_), at, true, pred, ctx);
+          : StampCheck(GnssVelocityFactor::Create(m.v_w, m.sigma_w, omega_b, lever_b_), at, true, pred, ctx);
   const FactorCheck check = gate.Run();
   if (!check.Passes(gate_)) {
     counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
@@ -262,11 +262,11 @@ bool GvelAttacher::OnGvel(const GvelMeasurement& m, const AttachContext& ctx) {
     ceres::CostFunction* cost = DelayedFactor(model, a, pred, ctx, &blocks);
     ctx.keyframes.AddFactor(cost, loss_.get(), blocks);
   } else if (a.partial == nullptr) {
-    ctx.keyframes.AddFactor(GvelFactor::Create(m.v_w, m.sigma_w, omega_b, lever_b_), loss_.get(),
+    ctx.keyframes.AddFactor(GnssVelocityFactor::Create(m.v_w, m.sigma_w, omega_b, lever_b_), loss_.get(),
                             {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}});
   } else {
     ctx.keyframes.AddFactor(
-        PreintAttachedFactor<GvelAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb), model),
+        PreintAttachedFactor<GnssVelocityAtTime>::Create(a.partial, ctx.EarthTermsAt(pred.x.p_wb), model),
         loss_.get(), {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}});
   }
   ++counts_.used;

@@ -13,7 +13,7 @@
 // The attachers here:
 // - GnssAttacher: position and dual-antenna heading; a run of rejected fixes that agree with one another
 //   inflates the gate (GateInflation, solver/estimator_common.h), and a fix accepted under it relieves the prior.
-// - GvelAttacher: GNSS (Doppler) velocity.
+// - GnssVelocityAttacher: GNSS (Doppler) velocity.
 // - StandstillAttacher: from the session's detector, a zero-velocity factor on each keyframe inside a
 //   standstill (checked against the predicted velocity, not above standstill.max_speed_m_s), and a
 //   zero-motion factor (no translation, 0.1 mm; no rotation, the gyro noise over the interval) between
@@ -95,7 +95,7 @@ class MeasurementAttacher {
   // A measurement arrived (the smoother is initialised); true if a factor was attached (the window is
   // then solved before the next IMU sample).
   virtual bool OnGnss(const GnssMeasurement& /*m*/, const AttachContext& /*ctx*/) { return false; }
-  virtual bool OnGvel(const GvelMeasurement& /*m*/, const AttachContext& /*ctx*/) { return false; }
+  virtual bool OnGnssVelocity(const GnssVelocityMeasurement& /*m*/, const AttachContext& /*ctx*/) { return false; }
   virtual void OnWheel(const WheelMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
   virtual void OnStandstill(const StandstillMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
   // An IMU step was integrated from the newest keyframe (before the keyframe it ends at, if any, is made).
@@ -140,10 +140,10 @@ class GnssAttacher final : public MeasurementAttacher {
   MeasurementCounts position_counts_, heading_counts_;
 };
 
-class GvelAttacher final : public MeasurementAttacher {
+class GnssVelocityAttacher final : public MeasurementAttacher {
  public:
-  explicit GvelAttacher(const GnssOptions& gnss);
-  bool OnGvel(const GvelMeasurement& m, const AttachContext& ctx) override;
+  explicit GnssVelocityAttacher(const GnssOptions& gnss);
+  bool OnGnssVelocity(const GnssVelocityMeasurement& m, const AttachContext& ctx) override;
   void AddStats(nlohmann::json* stats) const override { (*stats)["gnss_velocity"] = counts_.ToJson(); }
 
  private:

@@ -165,7 +165,7 @@ bool LogReader::Next(Record* record) {
 
 ReadCounts LogReader::counts() const {
   const ReadStats& s = impl_->reader->stats();
-  return {s.lines, s.imu, s.odom, s.gnss, s.gvel, s.total_skipped()};
+  return {s.lines, s.imu, s.wheel, s.gnss, s.gnss_velocity, s.total_skipped()};
 }
 
 bool LogReader::stopped() const { return impl_->reader->stopped(); }

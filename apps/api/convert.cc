@@ -22,8 +22,8 @@ LogRecord ToLogRecord(const Imu& m) {
 
 LogRecord ToLogRecord(const Wheel& m) {
   LogRecord r;
-  r.type = LogRecord::Type::kOdom;
-  r.odom = {m.t, m.left_pulses, m.right_pulses};
+  r.type = LogRecord::Type::kWheel;
+  r.wheel = {m.t, m.left_pulses, m.right_pulses};
   return r;
 }
 
@@ -36,8 +36,8 @@ LogRecord ToLogRecord(const Gnss& m) {
 
 LogRecord ToLogRecord(const GnssVelocity& m) {
   LogRecord r;
-  r.type = LogRecord::Type::kGvel;
-  r.gvel = {m.t, V(m.v_enu), m.has_sigma, V(m.sigma_enu)};
+  r.type = LogRecord::Type::kGnssVelocity;
+  r.gnss_velocity = {m.t, V(m.v_enu), m.has_sigma, V(m.sigma_enu)};
   return r;
 }
 
@@ -71,9 +71,9 @@ Record ToRecord(const LogRecord& r) {
       Copy(r.imu.gyro, out.imu.gyro);
       Copy(r.imu.acc, out.imu.acc);
       break;
-    case LogRecord::Type::kOdom:
+    case LogRecord::Type::kWheel:
       out.type = Record::Type::kWheel;
-      out.wheel = {r.odom.t, r.odom.left_pulses, r.odom.right_pulses};
+      out.wheel = {r.wheel.t, r.wheel.left_pulses, r.wheel.right_pulses};
       break;
     case LogRecord::Type::kGnss: {
       const GnssRecord& g = r.gnss;
@@ -82,12 +82,12 @@ Record ToRecord(const LogRecord& r) {
       Copy(g.sigma_enu, out.gnss.sigma_enu);
       break;
     }
-    case LogRecord::Type::kGvel:
+    case LogRecord::Type::kGnssVelocity:
       out.type = Record::Type::kGnssVelocity;
-      out.gnss_velocity.t = r.gvel.t;
-      Copy(r.gvel.v_enu, out.gnss_velocity.v_enu);
-      out.gnss_velocity.has_sigma = r.gvel.has_sigma;
-      Copy(r.gvel.sigma_enu, out.gnss_velocity.sigma_enu);
+      out.gnss_velocity.t = r.gnss_velocity.t;
+      Copy(r.gnss_velocity.v_enu, out.gnss_velocity.v_enu);
+      out.gnss_velocity.has_sigma = r.gnss_velocity.has_sigma;
+      Copy(r.gnss_velocity.sigma_enu, out.gnss_velocity.sigma_enu);
       break;
   }
   return out;
@@ -129,11 +129,11 @@ const char* MeasurementName(LogRecord::Type type) {
   switch (type) {
     case LogRecord::Type::kImu:
       return "imu";
-    case LogRecord::Type::kOdom:
+    case LogRecord::Type::kWheel:
       return "wheel";
     case LogRecord::Type::kGnss:
       return "gnss";
-    case LogRecord::Type::kGvel:
+    case LogRecord::Type::kGnssVelocity:
       return "gnss_velocity";
   }
   return "?";

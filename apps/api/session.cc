@@ -50,7 +50,7 @@ class Session::Impl {
   ::gins::Session session_;
   ReorderBuffer reorder_;
   // The IMU's and the wheels' stamps, regularised in arrival order (input.regularize_stamps).
-  SampleClock imu_clock_, odom_clock_;
+  SampleClock imu_clock_, wheel_clock_;
   const ImuRange imu_range_;  // a pushed IMU record beyond it is damage, as in a log
   StateCallback callback_;
   std::deque<State> queue_;
@@ -71,7 +71,7 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
       // GNSS records taken back by gnss.time_offset_s must still find their place among the IMU's.
       reorder_(options_.input.reorder_window + std::abs(options_.gnss.time_offset)),
       imu_clock_(options_.imu.max_gap),
-      odom_clock_(options_.imu.max_gap + options_.wheel.interval),
+      wheel_clock_(options_.imu.max_gap + options_.wheel.interval),
       imu_range_(ReaderOptions(options_).imu_range) {
   session_.SetParallel(session_options_.parallel);
   const Mode mode = session_options_.mode;
@@ -99,10 +99,10 @@ bool Session::Impl::Push(LogRecord record) {
   if (CheckLogRecord(&record, &issue_, imu_range_) == LineParse::kDamaged) return Reject(record.type, issue_.reason);
   // At the IMU time of their measurement (gnss.time_offset_s).
   if (record.type == LogRecord::Type::kGnss) record.gnss.t -= options_.gnss.time_offset;
-  if (record.type == LogRecord::Type::kGvel) record.gvel.t -= options_.gnss.time_offset;
+  if (record.type == LogRecord::Type::kGnssVelocity) record.gnss_velocity.t -= options_.gnss.time_offset;
   if (options_.input.regularize_stamps) {
     if (record.type == LogRecord::Type::kImu) record.imu.t = imu_clock_.Stamp(record.imu.t);
-    if (record.type == LogRecord::Type::kOdom) record.odom.t = odom_clock_.Stamp(record.odom.t);
+    if (record.type == LogRecord::Type::kWheel) record.wheel.t = wheel_clock_.Stamp(record.wheel.t);
   }
   try {
     if (!reorder_.Add(record, [this](const LogRecord& r) { Dispatch(r); })) return Reject(record.type, "late");
@@ -226,8 +226,8 @@ nlohmann::json Session::Impl::Stats() const {
                   {summary_keys::kStamps,
                    {{"imu_regularized", imu_clock_.regularized()},
                     {"imu_max_correction_s", imu_clock_.max_correction()},
-                    {"odom_regularized", odom_clock_.regularized()},
-                    {"odom_max_correction_s", odom_clock_.max_correction()}}},
+                    {"odom_regularized", wheel_clock_.regularized()},
+                    {"odom_max_correction_s", wheel_clock_.max_correction()}}},
                   {"rejected", rejected},
                   {"states", states_},
                   {"states_dropped", states_dropped_},

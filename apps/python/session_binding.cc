@@ -110,7 +110,7 @@ struct GnssColumns {
   }
 };
 
-struct GvelColumns {
+struct GnssVelocityColumns {
   Column t, v;
   std::optional<Column> sigma;
   api::GnssVelocity Make(py::ssize_t i) const {
@@ -193,7 +193,7 @@ class PySession {
 
   py::object PushGnssVelocity(const DoubleArray& t, const DoubleArray& v, const py::object& sigma) {
     Batch b;
-    GvelColumns g{b.Required(t, 1, "t"), b.Required(v, 3, "v_enu"), std::nullopt};
+    GnssVelocityColumns g{b.Required(t, 1, "t"), b.Required(v, 3, "v_enu"), std::nullopt};
     const std::optional<DoubleArray> s = OptionalArray(sigma);
     if (s) g.sigma = b.Broadcast(*s, 3, "sigma_enu");
     return PushAll(b.n(), [&](py::ssize_t i) { return g.Make(i); });
@@ -326,7 +326,7 @@ uint64_t PySession::PushRecords(const py::object& log) {
   keep.reserve(32);
   Column imu[3], wheel[3];
   GnssColumns gnss{};
-  GvelColumns gvel{};
+  GnssVelocityColumns gnss_velocity{};
   py::ssize_t n[4] = {0, 0, 0, 0};
   std::vector<std::optional<py::array_t<uint64_t, py::array::c_style | py::array::forcecast>>> lines(4);
   for (int k = 0; k < 4; ++k) {
@@ -358,10 +358,10 @@ uint64_t PySession::PushRecords(const py::object& log) {
         break;
       }
       case 3:
-        gvel.t = b.Required(need(k, "t"), 1, "gnss_velocity t");
-        gvel.v = b.Required(need(k, "v_enu"), 3, "gnss_velocity v_enu");
+        gnss_velocity.t = b.Required(need(k, "t"), 1, "gnss_velocity t");
+        gnss_velocity.v = b.Required(need(k, "v_enu"), 3, "gnss_velocity v_enu");
         if (!Get(parts[k], "sigma_enu").is_none()) {
-          gvel.sigma = b.Broadcast(need(k, "sigma_enu"), 3, "gnss_velocity sigma_enu");
+          gnss_velocity.sigma = b.Broadcast(need(k, "sigma_enu"), 3, "gnss_velocity sigma_enu");
         }
         break;
     }
@@ -377,7 +377,7 @@ uint64_t PySession::PushRecords(const py::object& log) {
   }
   bool by_line = true;
   for (int k = 0; k < 4; ++k) by_line = by_line && (n[k] == 0 || lines[k].has_value());
-  const Column* times[4] = {&imu[0], &wheel[0], &gnss.t, &gvel.t};
+  const Column* times[4] = {&imu[0], &wheel[0], &gnss.t, &gnss_velocity.t};
 
   Guard guard(this);
   pushed_ = true;
@@ -411,7 +411,7 @@ uint64_t PySession::PushRecords(const py::object& log) {
           ok = session_->Push(gnss.Make(e.i));
           break;
         case 3:
-          ok = session_->Push(gvel.Make(e.i));
+          ok = session_->Push(gnss_velocity.Make(e.i));
           break;
       }
       taken += ok ? 1 : 0;

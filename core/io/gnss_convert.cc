@@ -18,7 +18,7 @@ class LogSource : public RecordSource {
   }
   bool Next(LogRecord* r) override {
     while (reader_.Next(r)) {
-      if (r->type == LogRecord::Type::kGnss || r->type == LogRecord::Type::kGvel) {
+      if (r->type == LogRecord::Type::kGnss || r->type == LogRecord::Type::kGnssVelocity) {
         ++(r->type == LogRecord::Type::kGnss ? input_->dropped_gnss : input_->dropped_gvel);
         continue;
       }

@@ -30,10 +30,10 @@ using log_limits::kMinAlt;
 
 // Names of the numeric fields after the type token, for messages.
 constexpr const char* kImuFields[] = {"t", "gx", "gy", "gz", "ax", "ay", "az"};
-constexpr const char* kOdomFields[] = {"t", "left_pulses", "right_pulses"};
+constexpr const char* kWheelFields[] = {"t", "left_pulses", "right_pulses"};
 constexpr const char* kGnssFields[] = {"t",       "lat",     "lon",    "alt", "heading", "heading_valid",
                                        "sigma_e", "sigma_n", "sigma_u"};
-constexpr const char* kGvelFields[] = {"t", "ve", "vn", "vu", "sigma_e", "sigma_n", "sigma_u"};
+constexpr const char* kGnssVelocityFields[] = {"t", "ve", "vn", "vu", "sigma_e", "sigma_n", "sigma_u"};
 constexpr size_t kMaxNumbers = 9;               // GNSS with σ
 constexpr size_t kMaxTokens = kMaxNumbers + 1;  // plus the type
 
@@ -97,7 +97,7 @@ std::string CheckImu(const double* v, const ImuRange& range) {
 std::string CheckOdom(const double* v) {
   for (size_t i = 1; i <= 2; ++i) {
     if (!(std::abs(v[i]) < kMaxAbsPulses)) {
-      return FieldValue(i, kOdomFields[i], v[i]) + ", |pulses| must be < " + Num(kMaxAbsPulses);
+      return FieldValue(i, kWheelFields[i], v[i]) + ", |pulses| must be < " + Num(kMaxAbsPulses);
     }
   }
   return {};
@@ -126,15 +126,15 @@ std::string CheckGnss(const double* v, size_t n) {
   return {};
 }
 
-std::string CheckGvel(const double* v, size_t n) {
+std::string CheckGnssVelocity(const double* v, size_t n) {
   for (size_t i = 1; i <= 3; ++i) {
     if (!(std::abs(v[i]) <= log_limits::kMaxAbsSpeed)) {
-      return FieldValue(i, kGvelFields[i], v[i]) + " m/s, beyond ±" + Num(log_limits::kMaxAbsSpeed);
+      return FieldValue(i, kGnssVelocityFields[i], v[i]) + " m/s, beyond ±" + Num(log_limits::kMaxAbsSpeed);
     }
   }
   for (size_t i = 4; i < n; ++i) {
     if (!(v[i] > 0.0 && v[i] < log_limits::kMaxAbsSpeed)) {
-      return FieldValue(i, kGvelFields[i], v[i]) + " m/s, σ must be in (0, " + Num(log_limits::kMaxAbsSpeed) + ")";
+      return FieldValue(i, kGnssVelocityFields[i], v[i]) + " m/s, σ must be in (0, " + Num(log_limits::kMaxAbsSpeed) + ")";
     }
   }
   return {};
@@ -157,16 +157,16 @@ bool ClassifyType(const Tokens& tokens, LogRecord* record, const char* const** n
     *names = kImuFields;
     *expected = 7;
   } else if (type == "ODOM") {
-    record->type = LogRecord::Type::kOdom;
-    *names = kOdomFields;
+    record->type = LogRecord::Type::kWheel;
+    *names = kWheelFields;
     *expected = 3;
   } else if (type == "GNSS") {
     record->type = LogRecord::Type::kGnss;
     *names = kGnssFields;
     *expected = tokens.count - 1 >= 9 ? 9 : 6;
   } else if (type == "GVEL") {
-    record->type = LogRecord::Type::kGvel;
-    *names = kGvelFields;
+    record->type = LogRecord::Type::kGnssVelocity;
+    *names = kGnssVelocityFields;
     *expected = tokens.count - 1 >= 7 ? 7 : 4;
   } else {
     return false;
@@ -178,15 +178,15 @@ bool ClassifyType(const Tokens& tokens, LogRecord* record, const char* const** n
 LineParse CheckFieldCount(LogRecord::Type type, const char* const* names, size_t n, size_t expected,
                           InputIssue* issue) {
   // GNSS and GVEL take their three σ columns all or none.
-  const bool gnss = type == LogRecord::Type::kGnss, gvel = type == LogRecord::Type::kGvel;
+  const bool gnss = type == LogRecord::Type::kGnss, gnss_velocity = type == LogRecord::Type::kGnssVelocity;
   const size_t with_sigma = gnss ? 9 : 7;
-  if ((gnss || gvel) && n > with_sigma - 3 && n < with_sigma) {
+  if ((gnss || gnss_velocity) && n > with_sigma - 3 && n < with_sigma) {
     return Damaged(issue, kMissingFields,
                    std::string(LogRecordTypeName(type)) + " has " + std::to_string(n) +
                        " values; sigma_e sigma_n sigma_u come all three or none");
   }
   if (n != expected) {
-    const bool optional = gnss || gvel;
+    const bool optional = gnss || gnss_velocity;
     std::string detail = std::string(LogRecordTypeName(type)) + " has " + std::to_string(n) + " values, needs " +
                          (optional ? std::to_string(with_sigma - 3) + " or " + std::to_string(with_sigma)
                                    : std::to_string(expected)) +
@@ -211,14 +211,14 @@ LineParse CheckValues(LogRecord::Type type, size_t n, const double* v, const Imu
     case LogRecord::Type::kImu:
       absurd = CheckImu(v, range);
       break;
-    case LogRecord::Type::kOdom:
+    case LogRecord::Type::kWheel:
       absurd = CheckOdom(v);
       break;
     case LogRecord::Type::kGnss:
       absurd = CheckGnss(v, n);
       break;
-    case LogRecord::Type::kGvel:
-      absurd = CheckGvel(v, n);
+    case LogRecord::Type::kGnssVelocity:
+      absurd = CheckGnssVelocity(v, n);
       break;
   }
   if (!absurd.empty()) return Damaged(issue, kAbsurdValue, std::move(absurd));
@@ -246,10 +246,10 @@ void FillRecord(const double* v, size_t n, LogRecord* record) {
       record->imu.gyro = Vec3(v[1], v[2], v[3]);
       record->imu.acc = Vec3(v[4], v[5], v[6]);
       break;
-    case LogRecord::Type::kOdom:
-      record->odom.t = v[0];
-      record->odom.left_pulses = v[1];
-      record->odom.right_pulses = v[2];
+    case LogRecord::Type::kWheel:
+      record->wheel.t = v[0];
+      record->wheel.left_pulses = v[1];
+      record->wheel.right_pulses = v[2];
       break;
     case LogRecord::Type::kGnss: {
       GnssRecord& g = record->gnss;
@@ -263,8 +263,8 @@ void FillRecord(const double* v, size_t n, LogRecord* record) {
       g.sigma_enu = g.has_sigma ? Vec3(v[6], v[7], v[8]) : Vec3::Zero();
       break;
     }
-    case LogRecord::Type::kGvel: {
-      GvelRecord& g = record->gvel;
+    case LogRecord::Type::kGnssVelocity: {
+      GnssVelocityRecord& g = record->gnss_velocity;
       g.t = v[0];
       g.v_enu = Vec3(v[1], v[2], v[3]);
       g.has_sigma = n == 7;
@@ -284,9 +284,9 @@ size_t RecordValues(const LogRecord& record, double* v, const char* const** name
       std::copy(std::begin(values), std::end(values), v);
       return 7;
     }
-    case LogRecord::Type::kOdom:
-      *names = kOdomFields;
-      v[0] = record.odom.t, v[1] = record.odom.left_pulses, v[2] = record.odom.right_pulses;
+    case LogRecord::Type::kWheel:
+      *names = kWheelFields;
+      v[0] = record.wheel.t, v[1] = record.wheel.left_pulses, v[2] = record.wheel.right_pulses;
       return 3;
     case LogRecord::Type::kGnss: {
       const GnssRecord& g = record.gnss;
@@ -296,9 +296,9 @@ size_t RecordValues(const LogRecord& record, double* v, const char* const** name
       std::copy(std::begin(values), std::end(values), v);
       return g.has_sigma ? 9 : 6;
     }
-    case LogRecord::Type::kGvel: {
-      const GvelRecord& g = record.gvel;
-      *names = kGvelFields;
+    case LogRecord::Type::kGnssVelocity: {
+      const GnssVelocityRecord& g = record.gnss_velocity;
+      *names = kGnssVelocityFields;
       const double values[] = {g.t, g.v_enu.x(), g.v_enu.y(), g.v_enu.z(), g.sigma_enu.x(), g.sigma_enu.y(),
                                g.sigma_enu.z()};
       std::copy(std::begin(values), std::end(values), v);

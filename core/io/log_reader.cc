@@ -162,14 +162,14 @@ void LogReader::Impl::Accept(LogRecord* record, uint64_t line) {
     case LogRecord::Type::kImu:
       ++stats_->imu;
       break;
-    case LogRecord::Type::kOdom:
-      ++stats_->odom;
+    case LogRecord::Type::kWheel:
+      ++stats_->wheel;
       break;
     case LogRecord::Type::kGnss:
       ++stats_->gnss;
       break;
-    case LogRecord::Type::kGvel:
-      ++stats_->gvel;
+    case LogRecord::Type::kGnssVelocity:
+      ++stats_->gnss_velocity;
       break;
   }
 }

@@ -90,7 +90,7 @@ std::string FormatIssueCounts(const char* kind, const std::map<std::string, uint
 
 struct ReadStats {
   uint64_t lines = 0;
-  uint64_t imu = 0, odom = 0, gnss = 0, gvel = 0;  // records accepted
+  uint64_t imu = 0, wheel = 0, gnss = 0, gnss_velocity = 0;  // records accepted
   std::map<std::string, uint64_t> skipped;  // reason -> count
   std::vector<InputIssue> examples;        // up to kMaxExamplesPerReason per reason
   // Every damaged line's number, by reason (at most input.max_errors + 1 in all: then the read stops).

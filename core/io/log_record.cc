@@ -9,12 +9,12 @@ auto& Stamp(Record& r) {
   switch (r.type) {
     case LogRecord::Type::kImu:
       return r.imu.t;
-    case LogRecord::Type::kOdom:
-      return r.odom.t;
+    case LogRecord::Type::kWheel:
+      return r.wheel.t;
     case LogRecord::Type::kGnss:
       return r.gnss.t;
-    case LogRecord::Type::kGvel:
-      return r.gvel.t;
+    case LogRecord::Type::kGnssVelocity:
+      return r.gnss_velocity.t;
   }
   return r.imu.t;
 }
@@ -28,11 +28,11 @@ const char* LogRecordTypeName(LogRecord::Type type) {
   switch (type) {
     case LogRecord::Type::kImu:
       return "IMU";
-    case LogRecord::Type::kOdom:
+    case LogRecord::Type::kWheel:
       return "ODOM";
     case LogRecord::Type::kGnss:
       return "GNSS";
-    case LogRecord::Type::kGvel:
+    case LogRecord::Type::kGnssVelocity:
       return "GVEL";
   }
   return "?";

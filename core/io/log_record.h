@@ -11,14 +11,14 @@
 namespace gins {
 
 struct LogRecord {
-  enum class Type { kImu, kOdom, kGnss, kGvel };
+  enum class Type { kImu, kWheel, kGnss, kGnssVelocity };
   static constexpr int kNumTypes = 4;
   Type type = Type::kImu;
   uint64_t line = 0;  // 1-based line number in the file
   ImuSample imu;      // valid when type == kImu
-  OdomRecord odom;    // valid when type == kOdom
+  WheelRecord wheel;    // valid when type == kWheel
   GnssRecord gnss;    // valid when type == kGnss
-  GvelRecord gvel;    // valid when type == kGvel
+  GnssVelocityRecord gnss_velocity;    // valid when type == kGnssVelocity
   double t() const;
   void set_t(double t);  // of the member that type names
 };

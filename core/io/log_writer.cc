@@ -113,7 +113,7 @@ void LogWriter::Gnss(const GnssRecord& g) {
   ++records_;
 }
 
-void LogWriter::Odom(const OdomRecord& o) {
+void LogWriter::Odom(const WheelRecord& o) {
   buf_ += "ODOM";
   AppendNumber(&buf_, o.t);
   AppendNumber(&buf_, o.left_pulses);
@@ -122,7 +122,7 @@ void LogWriter::Odom(const OdomRecord& o) {
   ++records_;
 }
 
-void LogWriter::Gvel(const GvelRecord& v) {
+void LogWriter::Gvel(const GnssVelocityRecord& v) {
   buf_ += "GVEL";
   AppendNumber(&buf_, v.t);
   for (int i = 0; i < 3; ++i) AppendNumber(&buf_, v.v_enu[i]);
@@ -137,12 +137,12 @@ void LogWriter::Add(const LogRecord& r) {
   switch (r.type) {
     case LogRecord::Type::kImu:
       return Imu(r.imu);
-    case LogRecord::Type::kOdom:
-      return Odom(r.odom);
+    case LogRecord::Type::kWheel:
+      return Odom(r.wheel);
     case LogRecord::Type::kGnss:
       return Gnss(r.gnss);
-    case LogRecord::Type::kGvel:
-      return Gvel(r.gvel);
+    case LogRecord::Type::kGnssVelocity:
+      return Gvel(r.gnss_velocity);
   }
 }
 

@@ -26,8 +26,8 @@ class LogWriter {
   void Comment(std::string_view text);
   void Imu(const ImuSample& s);     // IMU t gx gy gz ax ay az
   void Gnss(const GnssRecord& g);   // GNSS t lat lon alt heading valid [σe σn σu]
-  void Odom(const OdomRecord& o);   // ODOM t left_pulses right_pulses
-  void Gvel(const GvelRecord& v);   // GVEL t ve vn vu [σe σn σu]
+  void Odom(const WheelRecord& o);   // ODOM t left_pulses right_pulses
+  void Gvel(const GnssVelocityRecord& v);   // GVEL t ve vn vu [σe σn σu]
   void Add(const LogRecord& r);     // the one of the four its type names
   // Finishes the file and renames it into place; throws std::runtime_error on any I/O error. Without
   // Commit() the file never appears.

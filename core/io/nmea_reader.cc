@@ -227,13 +227,13 @@ void NmeaReader::Emit(const Epoch& e, double t, int leap) {
   }
   if (!e.has_velocity) return;
   LogRecord r;
-  r.type = LogRecord::Type::kGvel;
-  r.gvel.t = t;
-  r.gvel.v_enu = e.v_enu;
-  r.gvel.has_sigma = true;
+  r.type = LogRecord::Type::kGnssVelocity;
+  r.gnss_velocity.t = t;
+  r.gnss_velocity.v_enu = e.v_enu;
+  r.gnss_velocity.has_sigma = true;
   // NMEA has no vertical speed: vu = 0 with a σ that allows a grade of vertical_sigma_per_speed.
   const double h = format_.velocity_sigma_m_s;
-  r.gvel.sigma_enu =
+  r.gnss_velocity.sigma_enu =
       Vec3(h, h, std::max(format_.vertical_velocity_sigma_m_s, format_.vertical_sigma_per_speed * e.speed));
   if (Accept(&r, e.first_line, &lines_.issues(), "", leap)) pending_.push_back(r);
 }

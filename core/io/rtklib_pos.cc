@@ -293,14 +293,14 @@ const char* RtklibPosReader::Convert(const TextLine& line, std::string* detail) 
     if (const char* reason = ReadSigma(layout_.sd, sd, detail)) return reason;
   }
   LogRecord vel;
-  vel.type = LogRecord::Type::kGvel;
+  vel.type = LogRecord::Type::kGnssVelocity;
   const bool has_vel = layout_.vel[0] >= 0 && layout_.vel[1] >= 0 && layout_.vel[2] >= 0;
   Vec3 v;
   for (int i = 0; i < 3 && has_vel; ++i) {
     if (const char* reason = Number(layout_.vel[i], "velocity", &v[i], detail)) return reason;
   }
-  vel.gvel.has_sigma = has_vel && layout_.sdv[0] >= 0 && layout_.sdv[1] >= 0 && layout_.sdv[2] >= 0;
-  if (vel.gvel.has_sigma) {
+  vel.gnss_velocity.has_sigma = has_vel && layout_.sdv[0] >= 0 && layout_.sdv[1] >= 0 && layout_.sdv[2] >= 0;
+  if (vel.gnss_velocity.has_sigma) {
     if (const char* reason = ReadSigma(layout_.sdv, sdv, detail)) return reason;
   }
   // Everything parsed: now the order, then what is kept.
@@ -330,10 +330,10 @@ const char* RtklibPosReader::Convert(const TextLine& line, std::string* detail) 
   if (!Accept(&fix, line.number, &lines_.issues(), FixQualityName(quality), leap)) return nullptr;
   pending_.push_back(fix);
   if (!has_vel) return nullptr;
-  vel.gvel.t = t;
-  vel.gvel.v_enu = ecef ? Vec3(R_ecef_enu.transpose() * v) : v;
-  if (vel.gvel.has_sigma) {
-    vel.gvel.sigma_enu =
+  vel.gnss_velocity.t = t;
+  vel.gnss_velocity.v_enu = ecef ? Vec3(R_ecef_enu.transpose() * v) : v;
+  if (vel.gnss_velocity.has_sigma) {
+    vel.gnss_velocity.sigma_enu =
         ecef ? SigmaOf(R_ecef_enu.transpose() * Covariance(sdv) * R_ecef_enu) : Floored(sdv[0], sdv[1], sdv[2]);
   }
   if (Accept(&vel, line.number, &lines_.issues(), FixQualityName(quality), leap)) pending_.push_back(vel);

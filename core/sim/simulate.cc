@@ -30,10 +30,10 @@ void WriteLogHeader(const SimOptions& sim, const Simulator& simulator, AtomicFil
   if (sim.gnss_noise_correlation > 0.0) {
     CheckedPrintf(log, std::fprintf(log->stream(), " gnss_noise_correlation=%g", sim.gnss_noise_correlation));
   }
-  const bool gvel = (sim.gnss_velocity_sigma.array() > 0.0).any();
+  const bool gnss_velocity = (sim.gnss_velocity_sigma.array() > 0.0).any();
   CheckedPrintf(log, std::fprintf(log->stream(), "\n# IMU t gx gy gz ax ay az | ODOM t left right | GNSS t lat lon "
                                                  "alt heading valid%s%s\n",
-                                  sim.write_gnss_sigma ? " se sn su" : "", gvel ? " | GVEL t ve vn vu se sn su" : ""));
+                                  sim.write_gnss_sigma ? " se sn su" : "", gnss_velocity ? " | GVEL t ve vn vu se sn su" : ""));
 }
 
 // A truth row (docs/formats.md §4): attitude and velocity in the local ENU frame at the row's point, which is w for
@@ -73,21 +73,21 @@ void WriteRecord(const Simulator& simulator, const SimRecord& r, AtomicFile* log
       ++result->imu;
       break;
     }
-    case SimRecord::Type::kOdom:
+    case SimRecord::Type::kWheel:
       // Whole pulses, printed as integers (a rounded −0.4 would print as "-0" with %.0f).
-      CheckedPrintf(log, std::fprintf(log->stream(), "ODOM %.6f %lld %lld\n", r.odom.t,
-                                      std::llround(r.odom.left_pulses), std::llround(r.odom.right_pulses)));
-      ++result->odom;
+      CheckedPrintf(log, std::fprintf(log->stream(), "ODOM %.6f %lld %lld\n", r.wheel.t,
+                                      std::llround(r.wheel.left_pulses), std::llround(r.wheel.right_pulses)));
+      ++result->wheel;
       break;
     case SimRecord::Type::kGnss:
       WriteGnss(r.gnss, log);
       ++result->gnss;
       break;
-    case SimRecord::Type::kGvel: {
-      const GvelRecord& g = r.gvel;
+    case SimRecord::Type::kGnssVelocity: {
+      const GnssVelocityRecord& g = r.gnss_velocity;
       CheckedPrintf(log, std::fprintf(log->stream(), "GVEL %.6f %.4f %.4f %.4f %.4f %.4f %.4f\n", g.t, g.v_enu.x(),
                                       g.v_enu.y(), g.v_enu.z(), g.sigma_enu.x(), g.sigma_enu.y(), g.sigma_enu.z()));
-      ++result->gvel;
+      ++result->gnss_velocity;
       break;
     }
   }

@@ -82,7 +82,7 @@ Simulator::Simulator(const SimOptions& sim)
   if (sim.earth_rotation) earth_rate_w_ = EarthModel::Rotating(truth_.frame()).rate_w();
   n_imu_ = LastIndex(sim.imu_rate, d) + 1;
   n_gnss_ = sim.gnss_rate > 0.0 ? LastIndex(sim.gnss_rate, d) + 1 : 0;
-  n_odom_ = sim.wheel_rate > 0.0 ? LastIndex(sim.wheel_rate, d) + 1 : 1;  // indices 1..last
+  n_wheel_ = sim.wheel_rate > 0.0 ? LastIndex(sim.wheel_rate, d) + 1 : 1;  // indices 1..last
   bg_ = sim.gyro_turn_on_bias * rng_imu_bias_.Normal3();
   ba_ = sim.acc_turn_on_bias * rng_imu_bias_.Normal3();
 }
@@ -105,8 +105,8 @@ Mat3 Simulator::LocalToWorld(const Vec3& p_w) const {
 }
 
 bool Simulator::Generate(SimRecord* record, double* from) {
-  if (gvel_pending_) {  // right after its fix: a tie, and GVEL comes last
-    gvel_pending_ = false;
+  if (gnss_velocity_pending_) {  // right after its fix: a tie, and GVEL comes last
+    gnss_velocity_pending_ = false;
     *record = pending_;
     *from = pending_from_;
     return true;
@@ -115,18 +115,18 @@ bool Simulator::Generate(SimRecord* record, double* from) {
   for (;;) {
     // Elapsed times k/rate: equal rationals give equal doubles, so simultaneous samples tie exactly.
     const double t_imu = i_imu_ < n_imu_ ? static_cast<double>(i_imu_) / sim_.imu_rate : kNever;
-    const double t_odom = i_odom_ < n_odom_ ? static_cast<double>(i_odom_) / sim_.wheel_rate : kNever;
+    const double t_wheel = i_wheel_ < n_wheel_ ? static_cast<double>(i_wheel_) / sim_.wheel_rate : kNever;
     const double t_gnss = i_gnss_ < n_gnss_ ? static_cast<double>(i_gnss_) / sim_.gnss_rate : kNever;
-    if (t_imu == kNever && t_odom == kNever && t_gnss == kNever) return false;
+    if (t_imu == kNever && t_wheel == kNever && t_gnss == kNever) return false;
     *record = SimRecord();
-    if (t_imu <= t_odom && t_imu <= t_gnss) {
+    if (t_imu <= t_wheel && t_imu <= t_gnss) {
       *from = t_imu;
       MakeImu(record);
       return true;
     }
-    if (t_odom <= t_gnss) {
-      *from = static_cast<double>(i_odom_ - 1) / sim_.wheel_rate;  // the counting interval's start
-      MakeOdom(record);
+    if (t_wheel <= t_gnss) {
+      *from = static_cast<double>(i_wheel_ - 1) / sim_.wheel_rate;  // the counting interval's start
+      MakeWheel(record);
       return true;
     }
     *from = t_gnss;
@@ -169,10 +169,10 @@ void Simulator::MakeImu(SimRecord* r) {
   ++i_imu_;
 }
 
-void Simulator::MakeOdom(SimRecord* r) {
+void Simulator::MakeWheel(SimRecord* r) {
   const double dt = 1.0 / sim_.wheel_rate;
-  const double s1 = std::min(static_cast<double>(i_odom_) / sim_.wheel_rate, truth_.duration());
-  const double s0 = static_cast<double>(i_odom_ - 1) / sim_.wheel_rate;
+  const double s1 = std::min(static_cast<double>(i_wheel_) / sim_.wheel_rate, truth_.duration());
+  const double s0 = static_cast<double>(i_wheel_ - 1) / sim_.wheel_rate;
   // Distances of the wheel contact points: body speed ∓ half the track times the body yaw rate.
   const Vec2 integral = truth_.IntegrateSpeedAndYawRate(s0, s1);
   const double half_turn = 0.5 * sim_.track_width * integral.y();
@@ -183,12 +183,12 @@ void Simulator::MakeOdom(SimRecord* r) {
   const Vec2 counts = distance * sim_.pulses_per_rev / (2.0 * kPi * sim_.wheel_radius) + pulse_carry_;
   const Vec2 pulses(std::round(counts.x()), std::round(counts.y()));
   pulse_carry_ = counts - pulses;
-  r->type = SimRecord::Type::kOdom;
-  r->odom.t = sim_.start_time + static_cast<double>(i_odom_) / sim_.wheel_rate;
-  r->odom.left_pulses = pulses.x();
-  r->odom.right_pulses = pulses.y();
+  r->type = SimRecord::Type::kWheel;
+  r->wheel.t = sim_.start_time + static_cast<double>(i_wheel_) / sim_.wheel_rate;
+  r->wheel.left_pulses = pulses.x();
+  r->wheel.right_pulses = pulses.y();
   FillTruth(s1, r);
-  ++i_odom_;
+  ++i_wheel_;
 }
 
 bool Simulator::MakeGnss(SimRecord* r) {
@@ -233,7 +233,7 @@ bool Simulator::MakeGnss(SimRecord* r) {
   r->gnss_outlier = outlier;
   FillTruth(s, r);
   if ((sim_.gnss_velocity_sigma.array() > 0.0).any()) {
-    MakeGvel(s, x, p_ant_true_w, gvel_noise);
+    MakeGnssVelocity(s, x, p_ant_true_w, gvel_noise);
     pending_.truth = r->truth;
   }
   return true;
@@ -253,17 +253,17 @@ Vec3 Simulator::GnssError(const Vec3& normals) {
   return gnss_error_;
 }
 
-void Simulator::MakeGvel(double s, const TruthState& x, const Vec3& p_ant_w, const Vec3& normals) {
+void Simulator::MakeGnssVelocity(double s, const TruthState& x, const Vec3& p_ant_w, const Vec3& normals) {
   // Doppler measures the antenna's velocity against the Earth, given in the local ENU frame at the antenna.
   const Vec3 v_ant_w = x.v_w + x.q_wb * x.omega_b.cross(sim_.lever_b);
   pending_ = SimRecord();
-  pending_.type = SimRecord::Type::kGvel;
-  pending_.gvel.t = sim_.start_time + s;
-  pending_.gvel.v_enu = LocalToWorld(p_ant_w).transpose() * v_ant_w + sim_.gnss_velocity_sigma.cwiseProduct(normals);
-  pending_.gvel.has_sigma = true;
-  pending_.gvel.sigma_enu = sim_.gnss_velocity_sigma;
+  pending_.type = SimRecord::Type::kGnssVelocity;
+  pending_.gnss_velocity.t = sim_.start_time + s;
+  pending_.gnss_velocity.v_enu = LocalToWorld(p_ant_w).transpose() * v_ant_w + sim_.gnss_velocity_sigma.cwiseProduct(normals);
+  pending_.gnss_velocity.has_sigma = true;
+  pending_.gnss_velocity.sigma_enu = sim_.gnss_velocity_sigma;
   pending_from_ = s;
-  gvel_pending_ = true;
+  gnss_velocity_pending_ = true;
 }
 
 }  // namespace gins

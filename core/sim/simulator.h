@@ -249,7 +249,7 @@ class Simulator {
   // starts measuring at (its time, or the start of an encoder interval).
   bool Generate(SimRecord* r, double* from);
   void MakeImu(SimRecord* r);
-  void MakeOdom(SimRecord* r);
+  void MakeWheel(SimRecord* r);
   // Draws the fix's noise; false (no record) inside an outage. Queues the fix's GVEL record, if any.
   bool MakeGnss(SimRecord* r);
   // The GNSS position error of the epoch just counted in i_gnss_, from its standard normals (white or
@@ -257,7 +257,7 @@ class Simulator {
   Vec3 GnssError(const Vec3& normals);
   // Queues the GVEL record of the fix at elapsed s (truth x, true antenna position p_ant_w), all but its
   // truth.
-  void MakeGvel(double s, const TruthState& x, const Vec3& p_ant_w, const Vec3& normals);
+  void MakeGnssVelocity(double s, const TruthState& x, const Vec3& p_ant_w, const Vec3& normals);
   void FillTruth(double elapsed, SimRecord* r) const;
 
   SimOptions sim_;
@@ -265,18 +265,18 @@ class Simulator {
   Rng rng_imu_bias_, rng_imu_noise_, rng_gnss_, rng_heading_, rng_heading_valid_, rng_outlier_, rng_wheel_;
   Rng rng_gvel_;
   Vec3 earth_rate_w_ = Vec3::Zero();
-  uint64_t n_imu_ = 0, n_gnss_ = 0, n_odom_ = 0;  // samples in the drive per stream
-  uint64_t i_imu_ = 0, i_gnss_ = 0, i_odom_ = 1;  // next sample index per stream
+  uint64_t n_imu_ = 0, n_gnss_ = 0, n_wheel_ = 0;  // samples in the drive per stream
+  uint64_t i_imu_ = 0, i_gnss_ = 0, i_wheel_ = 1;  // next sample index per stream
   Vec3 bg_ = Vec3::Zero(), ba_ = Vec3::Zero();    // current true biases
   Vec2 pulse_carry_ = Vec2::Zero();               // sub-pulse remainders (left, right)
   Vec3 gnss_error_ = Vec3::Zero();                // the Gauss–Markov GNSS error of the last epoch
-  bool gvel_pending_ = false;                     // pending_ holds the last fix's GVEL record
+  bool gnss_velocity_pending_ = false;                     // pending_ holds the last fix's GVEL record
   SimRecord pending_;
   double pending_from_ = 0.0;
 };
 
 struct SimulationResult {
-  uint64_t imu = 0, gnss = 0, odom = 0, gvel = 0;
+  uint64_t imu = 0, gnss = 0, wheel = 0, gnss_velocity = 0;
   double duration = 0.0;  // s, of the whole drive (from start_time, whatever log_start)
 };
 

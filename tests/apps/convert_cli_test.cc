@@ -138,19 +138,19 @@ void WriteI2nav(const std::string& log, const std::string& imu_path, const std::
 // initial heading from a dual-antenna heading or, from the motion, against the wheels' dead reckoning: a
 // log with neither (an i2Nav conversion) does not initialise yet ("waiting for the vehicle to move").
 std::string WithWheels(const std::string& converted, const std::string& sim_log) {
-  std::vector<std::pair<double, std::string>> odom;
+  std::vector<std::pair<double, std::string>> wheel;
   for (const auto& line : Lines(test::ReadFile(sim_log))) {
-    if (line.rfind("ODOM ", 0) == 0) odom.emplace_back(std::stod(line.substr(5)), line);
+    if (line.rfind("ODOM ", 0) == 0) wheel.emplace_back(std::stod(line.substr(5)), line);
   }
   std::string merged;
   size_t i = 0;
   for (const auto& line : Lines(test::ReadFile(converted))) {
     const size_t space = line.find(' ');
     const double t = line[0] == '#' ? 0.0 : std::stod(line.substr(space + 1));
-    for (; i < odom.size() && odom[i].first < t; ++i) merged += odom[i].second + "\n";
+    for (; i < wheel.size() && wheel[i].first < t; ++i) merged += wheel[i].second + "\n";
     merged += line + "\n";
   }
-  for (; i < odom.size(); ++i) merged += odom[i].second + "\n";
+  for (; i < wheel.size(); ++i) merged += wheel[i].second + "\n";
   return merged;
 }
 

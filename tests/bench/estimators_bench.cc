@@ -182,7 +182,7 @@ class Recorder : public Estimator {
   void Initialize(const InitResult& init) override { *init_ = init; }
   void AddImu(const ImuSample& imu) override { inputs_->emplace_back(imu); }
   void AddGnss(const GnssMeasurement& gnss) override { inputs_->emplace_back(gnss); }
-  void AddGvel(const GvelMeasurement&) override {}  // the step drive has no GNSS velocity
+  void AddGnssVelocity(const GnssVelocityMeasurement&) override {}  // the step drive has no GNSS velocity
   void AddWheel(const WheelMeasurement& wheel) override { inputs_->emplace_back(wheel); }
   void AddStandstill(const StandstillMeasurement& m) override { inputs_->emplace_back(m); }
   void AddRestState(const StateEstimate&) override {}

@@ -174,9 +174,9 @@ TEST(DocsReferences, FormatsExampleLogReadsWithoutDamage) {
   while (reader.Next(&r)) records.push_back(r);
   EXPECT_EQ(reader.stats().total_skipped(), 0u);
   EXPECT_EQ(reader.stats().imu, 5u);
-  EXPECT_EQ(reader.stats().odom, 2u);
+  EXPECT_EQ(reader.stats().wheel, 2u);
   EXPECT_EQ(reader.stats().gnss, 2u);
-  EXPECT_EQ(reader.stats().gvel, 1u);
+  EXPECT_EQ(reader.stats().gnss_velocity, 1u);
   // §3.8: the first fix's heading with gnss.mount_yaw_deg 12.06 is a vehicle facing north-east (§2.4).
   const auto first_fix = std::find_if(records.begin(), records.end(),
                                       [](const LogRecord& x) { return x.type == LogRecord::Type::kGnss; });

@@ -46,15 +46,15 @@ InitRun Feed(const SimOptions& sim, const Options& options) {
       case SimRecord::Type::kImu:
         init.AddImu(rec.imu);
         break;
-      case SimRecord::Type::kOdom: {
+      case SimRecord::Type::kWheel: {
         const WheelOptions& wo = options.wheel;
         WheelMeasurement w;
-        w.t = rec.odom.t;
-        w.speed = 0.5 * (WheelSpeedFromPulses(rec.odom.left_pulses, wo.radius, wo.pulses_per_rev, wo.interval) +
-                         WheelSpeedFromPulses(rec.odom.right_pulses, wo.radius, wo.pulses_per_rev, wo.interval));
+        w.t = rec.wheel.t;
+        w.speed = 0.5 * (WheelSpeedFromPulses(rec.wheel.left_pulses, wo.radius, wo.pulses_per_rev, wo.interval) +
+                         WheelSpeedFromPulses(rec.wheel.right_pulses, wo.radius, wo.pulses_per_rev, wo.interval));
         w.sigma = wo.speed_sigma;
         w.interval = wo.interval;
-        w.standstill = rec.odom.left_pulses == 0.0 && rec.odom.right_pulses == 0.0;
+        w.standstill = rec.wheel.left_pulses == 0.0 && rec.wheel.right_pulses == 0.0;
         init.AddWheel(w);
         break;
       }
@@ -82,7 +82,7 @@ InitRun Feed(const SimOptions& sim, const Options& options) {
         }
         break;
       }
-      case SimRecord::Type::kGvel:  // these drives have none
+      case SimRecord::Type::kGnssVelocity:  // these drives have none
         break;
     }
   }

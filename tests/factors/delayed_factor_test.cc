@@ -67,7 +67,7 @@ TEST(DelayedFactorTest, HeadingJacobiansMatchAutodiffAndNumeric) {
 
 TEST(DelayedFactorTest, GnssVelocityJacobiansMatchAutodiffAndNumeric) {
   ExpectDelayedMatches(
-      GvelAtTime{Vec3(9.0, -3.0, 2.5), Vec3(10.0, 10.0, 5.0), Vec3(0.1, -0.2, 0.4), Vec3(0.3, -0.2, 1.1)}, "gvel");
+      GnssVelocityAtTime{Vec3(9.0, -3.0, 2.5), Vec3(10.0, 10.0, 5.0), Vec3(0.1, -0.2, 0.4), Vec3(0.3, -0.2, 1.1)}, "gvel");
 }
 
 TEST(DelayedFactorTest, AtZeroOffsetTheUndelayedFactors) {

@@ -66,7 +66,7 @@ TEST(PreintAttachedCostFunctionTest, HeadingMatchesAutodiffAndNumeric) {
 
 TEST(PreintAttachedCostFunctionTest, GnssVelocityMatchesAutodiffAndNumeric) {
   ExpectAnalyticMatches(
-      GvelAtTime{Vec3(9.0, -3.0, 2.5), Vec3(10.0, 10.0, 5.0), Vec3(0.1, -0.2, 0.4), Vec3(0.3, -0.2, 1.1)}, "gvel");
+      GnssVelocityAtTime{Vec3(9.0, -3.0, 2.5), Vec3(10.0, 10.0, 5.0), Vec3(0.1, -0.2, 0.4), Vec3(0.3, -0.2, 1.1)}, "gvel");
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 
 #include "factor_test_util.h"
 #include "factors/chord_factor.h"
-#include "factors/gvel_factor.h"
+#include "factors/gnss_velocity_factor.h"
 #include "factors/nhc_factor.h"
 #include "factors/odometer_factor.h"
 #include "factors/wheel_yaw_factor.h"
@@ -59,7 +59,7 @@ TEST(VehicleFactorsTest, ZeroOnAnArc) {
   const Vec3 lever_ant(0.5, -0.3, 1.2);
   const Vec3 z = v_imu + q * omega_b.cross(lever_ant);
   Vec3 r3;
-  GvelFactor(z, Vec3::Constant(0.05), omega_b, lever_ant)(pi.data(), v_imu.data(), r3.data());
+  GnssVelocityFactor(z, Vec3::Constant(0.05), omega_b, lever_ant)(pi.data(), v_imu.data(), r3.data());
   EXPECT_LT(r3.norm(), 1e-9);
 }
 
@@ -134,8 +134,8 @@ TEST(VehicleFactorsTest, JacobiansMatchNumeric) {
   const std::unique_ptr<ceres::CostFunction> chord(ChordFactor::Create(0.8, 0.1, kLever, Vec3(7.9, 0.6, -0.2)));
   const std::unique_ptr<ceres::CostFunction> yaw(WheelYawFactor::Create(0.3, 0.01));
   const std::unique_ptr<ceres::CostFunction> nhc(NhcFactor::Create(0.1, Vec3(0.01, -0.02, 0.3), kLever));
-  const std::unique_ptr<ceres::CostFunction> gvel(
-      GvelFactor::Create(Vec3(3, 4, 0.1), Vec3(0.05, 0.05, 0.1), Vec3(0.01, -0.02, 0.3), Vec3(0.5, -0.3, 1.2)));
+  const std::unique_ptr<ceres::CostFunction> gnss_velocity(
+      GnssVelocityFactor::Create(Vec3(3, 4, 0.1), Vec3(0.05, 0.05, 0.1), Vec3(0.01, -0.02, 0.3), Vec3(0.5, -0.3, 1.2)));
   for (int trial = 0; trial < 8; ++trial) {
     const test::PoseBlock pi = test::RandomPose(rng);
     const test::PoseBlock pj = test::RandomPoseNear(rng, pi, 5.0, 0.4);
@@ -146,7 +146,7 @@ TEST(VehicleFactorsTest, JacobiansMatchNumeric) {
     test::CheckJacobians(*chord, {&m, &m}, {pi.data(), pj.data()}, 1e-6, "chord " + what);
     test::CheckJacobians(*yaw, {&m, &m, nullptr}, {pi.data(), pj.data(), &s}, 1e-6, "wheel yaw " + what);
     test::CheckJacobians(*nhc, {&m, nullptr}, {pi.data(), v.data()}, 1e-6, "nhc " + what);
-    test::CheckJacobians(*gvel, {&m, nullptr}, {pi.data(), v.data()}, 1e-6, "gvel " + what);
+    test::CheckJacobians(*gnss_velocity, {&m, nullptr}, {pi.data(), v.data()}, 1e-6, "gvel " + what);
   }
 }
 

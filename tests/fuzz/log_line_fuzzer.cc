@@ -34,12 +34,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         case gins::LogRecord::Type::kImu:
           Require(record.imu.gyro.allFinite() && record.imu.acc.allFinite());
           break;
-        case gins::LogRecord::Type::kOdom:
-          Require(std::isfinite(record.odom.left_pulses) && std::isfinite(record.odom.right_pulses));
+        case gins::LogRecord::Type::kWheel:
+          Require(std::isfinite(record.wheel.left_pulses) && std::isfinite(record.wheel.right_pulses));
           break;
-        case gins::LogRecord::Type::kGvel:
-          Require(record.gvel.v_enu.allFinite() && record.gvel.v_enu.cwiseAbs().maxCoeff() <= 1000.0);
-          Require(!record.gvel.has_sigma || (record.gvel.sigma_enu.minCoeff() > 0.0 && record.gvel.sigma_enu.allFinite()));
+        case gins::LogRecord::Type::kGnssVelocity:
+          Require(record.gnss_velocity.v_enu.allFinite() && record.gnss_velocity.v_enu.cwiseAbs().maxCoeff() <= 1000.0);
+          Require(!record.gnss_velocity.has_sigma || (record.gnss_velocity.sigma_enu.minCoeff() > 0.0 && record.gnss_velocity.sigma_enu.allFinite()));
           break;
         case gins::LogRecord::Type::kGnss: {
           const gins::GnssRecord& g = record.gnss;

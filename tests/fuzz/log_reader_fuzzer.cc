@@ -31,7 +31,7 @@ void ReadAll(const std::string& path, const gins::InputOptions& options) {
       ++records;
     }
     const gins::ReadStats& s = reader.stats();
-    Require(s.imu + s.odom + s.gnss == records);
+    Require(s.imu + s.wheel + s.gnss == records);
     uint64_t listed = 0;
     for (const auto& [reason, lines] : s.skipped_lines) {
       Require(lines.size() == s.skipped.at(reason));

@@ -43,18 +43,18 @@ class Encoder {
       case LogRecord::Type::kImu:
         AddImu(r.imu, param);
         break;
-      case LogRecord::Type::kOdom:
+      case LogRecord::Type::kWheel:
         Put(param | kOpOdom);
-        Put24(static_cast<int32_t>(r.odom.left_pulses));
-        Put24(static_cast<int32_t>(r.odom.right_pulses));
+        Put24(static_cast<int32_t>(r.wheel.left_pulses));
+        Put24(static_cast<int32_t>(r.wheel.right_pulses));
         break;
       case LogRecord::Type::kGnss:
         AddGnss(r.gnss, param);
         break;
-      case LogRecord::Type::kGvel:
+      case LogRecord::Type::kGnssVelocity:
         Put(param | kOpGvel);
         Put(0);
-        for (int i = 0; i < 3; ++i) Put16(Cubic16Inverse(r.gvel.v_enu[i], log_limits::kMaxAbsSpeed));
+        for (int i = 0; i < 3; ++i) Put16(Cubic16Inverse(r.gnss_velocity.v_enu[i], log_limits::kMaxAbsSpeed));
         break;
     }
     t_ += kSteps[code];

@@ -155,7 +155,7 @@ class StreamDecoder {
   int burst_ = 0;
   double burst_t_ = 0.0;
   ImuSample last_imu_;              // in the log's IMU axes
-  double imu_dt_ = 0.01, grid_ = 0.0, jitter_ = 0.0, next_odom_ = 0.0, next_fix_ = 0.0;
+  double imu_dt_ = 0.01, grid_ = 0.0, jitter_ = 0.0, next_wheel_ = 0.0, next_fix_ = 0.0;
   int noise_ = 0, wheel_fault_ = 0, heading_fault_ = 0, mask_ = 0;
   double frozen_heading_ = -1.0;
   uint64_t rng_ = 0x9E3779B97F4A7C15ull;
@@ -207,7 +207,7 @@ inline void StreamDecoder::DecodeHeader() {
   t_ = kStartTimes[h2 & 15];
   imu_dt_ = kImuDt[(h2 >> 4) & 3];
   grid_ = t_ - imu_dt_;
-  next_odom_ = t_ + options_.wheel.interval;
+  next_wheel_ = t_ + options_.wheel.interval;
   next_fix_ = t_;
   base_frame_ = std::make_unique<LocalEnuFrame>(base_);
   g_norm_ = NormalGravity(base_.lat_deg, base_.alt_m);
@@ -242,14 +242,14 @@ inline void StreamDecoder::Emit(LogRecord r, double t) {
     case LogRecord::Type::kImu:
       r.imu.t = t;
       break;
-    case LogRecord::Type::kOdom:
-      r.odom.t = t;
+    case LogRecord::Type::kWheel:
+      r.wheel.t = t;
       break;
     case LogRecord::Type::kGnss:
       r.gnss.t = t;
       break;
-    case LogRecord::Type::kGvel:
-      r.gvel.t = t;
+    case LogRecord::Type::kGnssVelocity:
+      r.gnss_velocity.t = t;
       break;
   }
   t_ = t;
@@ -333,9 +333,9 @@ inline void StreamDecoder::RecordOp(Op op, double dt) {
     }
     last_imu_ = r.imu;
   } else if (op == kOpOdom) {
-    r.type = LogRecord::Type::kOdom;
-    r.odom.left_pulses = in_.I24();
-    r.odom.right_pulses = in_.I24();
+    r.type = LogRecord::Type::kWheel;
+    r.wheel.left_pulses = in_.I24();
+    r.wheel.right_pulses = in_.I24();
   } else if (op == kOpGnss) {
     r.type = LogRecord::Type::kGnss;
     const uint8_t flags = in_.U8();
@@ -358,11 +358,11 @@ inline void StreamDecoder::RecordOp(Op op, double dt) {
     r.gnss.lon_deg = g.lon_deg;
     r.gnss.alt_m = g.alt_m;
   } else {
-    r.type = LogRecord::Type::kGvel;
+    r.type = LogRecord::Type::kGnssVelocity;
     const uint8_t flags = in_.U8();
-    for (int i = 0; i < 3; ++i) r.gvel.v_enu[i] = Cubic16(in_.I16(), log_limits::kMaxAbsSpeed);
-    r.gvel.has_sigma = flags & 1;
-    if (r.gvel.has_sigma) r.gvel.sigma_enu = Vec3(GvelSigma(in_.U8()), GvelSigma(in_.U8()), GvelSigma(in_.U8()));
+    for (int i = 0; i < 3; ++i) r.gnss_velocity.v_enu[i] = Cubic16(in_.I16(), log_limits::kMaxAbsSpeed);
+    r.gnss_velocity.has_sigma = flags & 1;
+    if (r.gnss_velocity.has_sigma) r.gnss_velocity.sigma_enu = Vec3(GvelSigma(in_.U8()), GvelSigma(in_.U8()), GvelSigma(in_.U8()));
   }
   Emit(r, t_ + dt);
 }
@@ -401,10 +401,10 @@ inline void StreamDecoder::VehicleSample(uint8_t sensors, double accel, double y
   const bool with_imu = !(mask_ & 1);
   // In time order: the jittered IMU stamp may fall before or after the other sensors' epoch T.
   if (with_imu && imu_t <= T) Emit(imu, imu_t);
-  if (next_odom_ < T - options_.wheel.interval) next_odom_ = T;  // after a gap: the next epoch is now
-  if (next_odom_ <= T + 1e-9) {
+  if (next_wheel_ < T - options_.wheel.interval) next_wheel_ = T;  // after a gap: the next epoch is now
+  if (next_wheel_ <= T + 1e-9) {
     if ((sensors & 1) && !(mask_ & 2)) VehicleOdom(T);
-    next_odom_ += options_.wheel.interval;
+    next_wheel_ += options_.wheel.interval;
   }
   if (next_fix_ < T - 1.0) next_fix_ = T;
   if (next_fix_ <= T + 1e-9) {
@@ -420,8 +420,8 @@ inline void StreamDecoder::VehicleOdom(double t) {
   double pulses = wheel_fault_ == 2 ? 0.0 : car_.speed * w.interval * w.pulses_per_rev / (2.0 * kPi * w.radius);
   if (wheel_fault_ == 3) pulses *= 2.0;
   LogRecord r;
-  r.type = LogRecord::Type::kOdom;
-  r.odom.left_pulses = r.odom.right_pulses = std::round(std::min(pulses, log_limits::kMaxAbsPulses - 1.0));
+  r.type = LogRecord::Type::kWheel;
+  r.wheel.left_pulses = r.wheel.right_pulses = std::round(std::min(pulses, log_limits::kMaxAbsPulses - 1.0));
   Emit(r, t);
 }
 
@@ -449,8 +449,8 @@ inline void StreamDecoder::VehicleFix(double t, uint8_t sensors) {
   Emit(r, t);
   if ((sensors & 8) && !(mask_ & 8)) {
     LogRecord v;
-    v.type = LogRecord::Type::kGvel;
-    v.gvel.v_enu = car_.speed * Vec3(std::cos(car_.yaw), std::sin(car_.yaw), 0.0);
+    v.type = LogRecord::Type::kGnssVelocity;
+    v.gnss_velocity.v_enu = car_.speed * Vec3(std::cos(car_.yaw), std::sin(car_.yaw), 0.0);
     Emit(v, t);
   }
 }
@@ -463,8 +463,8 @@ inline std::string ToLogLine(const LogRecord& r) {
       std::snprintf(buf, sizeof(buf), "IMU %.17g %.17g %.17g %.17g %.17g %.17g %.17g", r.imu.t, r.imu.gyro.x(),
                     r.imu.gyro.y(), r.imu.gyro.z(), r.imu.acc.x(), r.imu.acc.y(), r.imu.acc.z());
       break;
-    case LogRecord::Type::kOdom:
-      std::snprintf(buf, sizeof(buf), "ODOM %.17g %.17g %.17g", r.odom.t, r.odom.left_pulses, r.odom.right_pulses);
+    case LogRecord::Type::kWheel:
+      std::snprintf(buf, sizeof(buf), "ODOM %.17g %.17g %.17g", r.wheel.t, r.wheel.left_pulses, r.wheel.right_pulses);
       break;
     case LogRecord::Type::kGnss: {
       const GnssRecord& g = r.gnss;
@@ -475,8 +475,8 @@ inline std::string ToLogLine(const LogRecord& r) {
       }
       break;
     }
-    case LogRecord::Type::kGvel: {
-      const GvelRecord& v = r.gvel;
+    case LogRecord::Type::kGnssVelocity: {
+      const GnssVelocityRecord& v = r.gnss_velocity;
       int n = std::snprintf(buf, sizeof(buf), "GVEL %.17g %.17g %.17g %.17g", v.t, v.v_enu.x(), v.v_enu.y(), v.v_enu.z());
       if (v.has_sigma) {
         std::snprintf(buf + n, sizeof(buf) - n, " %.17g %.17g %.17g", v.sigma_enu.x(), v.sigma_enu.y(), v.sigma_enu.z());

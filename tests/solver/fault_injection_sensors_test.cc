@@ -94,7 +94,7 @@ TEST(FaultInjection, WheelsStopReporting) {
   const SimOptions sim = FaultDrive(23, 155.0, /*keep_outage=*/true);
   const double t0 = sim.start_time + 40.0, outage = sim.start_time + 125.0, outage_end = outage + 20.0;
   const DriveRun run = test::RunDriveThroughSession(sim, test::TestRunOptions(sim), Editing([&](SimRecord* r) {
-    return !(r->type == SimRecord::Type::kOdom && r->t() >= t0);
+    return !(r->type == SimRecord::Type::kWheel && r->t() >= t0);
   }));
   ASSERT_TRUE(run.initialized);
   test::ExpectSaneOutputs(run);
@@ -188,7 +188,7 @@ TEST(FaultInjection, WheelsCountZeroWhileMoving) {
   const SimOptions sim = FaultDrive(27, 155.0, /*keep_outage=*/true);
   const double t0 = sim.start_time + 40.0, outage = sim.start_time + 125.0, outage_end = outage + 20.0;
   const DriveRun run = test::RunDriveThroughSession(sim, test::TestRunOptions(sim), Editing([&](SimRecord* r) {
-    if (r->type == SimRecord::Type::kOdom && r->t() >= t0) r->odom.left_pulses = r->odom.right_pulses = 0.0;
+    if (r->type == SimRecord::Type::kWheel && r->t() >= t0) r->wheel.left_pulses = r->wheel.right_pulses = 0.0;
     return true;
   }));
   ASSERT_TRUE(run.initialized);

@@ -179,7 +179,7 @@ TEST(FaultInjection, TimeStampJitter) {
   const DriveRun run = test::RunDriveThroughSession(
       sim, test::TestRunOptions(sim), [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, Session&) {
         SimRecord j = r;
-        const bool logger_stamped = r.type == SimRecord::Type::kImu || r.type == SimRecord::Type::kOdom;
+        const bool logger_stamped = r.type == SimRecord::Type::kImu || r.type == SimRecord::Type::kWheel;
         if (logger_stamped && r.t() >= t0 && r.t() < t1) test::SetTime(&j, r.t() + jitter(rng));
         if (reader.Accept(j)) feed(j);
       });

@@ -93,17 +93,17 @@ TEST_F(Csv, GnssColumnsByHeaderNameWithSigmaHeadingAndVelocity) {
   EXPECT_FALSE(g.heading_valid);  // an empty heading field: no heading at this fix
   EXPECT_TRUE(r.records[2].gnss.heading_valid);
   EXPECT_EQ(r.records[2].gnss.heading_deg, 90.0);
-  EXPECT_EQ(r.records[1].type, LogRecord::Type::kGvel);
-  EXPECT_EQ(r.records[1].gvel.v_enu, Vec3(1.0, 2.0, 0.1));
-  EXPECT_FALSE(r.records[1].gvel.has_sigma);
+  EXPECT_EQ(r.records[1].type, LogRecord::Type::kGnssVelocity);
+  EXPECT_EQ(r.records[1].gnss_velocity.v_enu, Vec3(1.0, 2.0, 0.1));
+  EXPECT_FALSE(r.records[1].gnss_velocity.has_sigma);
 }
 
 TEST_F(Csv, WheelColumnsBecomeOdomRecords) {
   const Read r = ReadText("t,l,r\n10.0, 5, 6\n10.1, -5, 7\n", "t=1,left=2,right=3", CsvKind::kWheel);
   ASSERT_EQ(r.records.size(), 2u);
-  EXPECT_EQ(r.records[1].type, LogRecord::Type::kOdom);
-  EXPECT_EQ(r.records[1].odom.left_pulses, -5.0);
-  EXPECT_EQ(r.records[1].odom.right_pulses, 7.0);
+  EXPECT_EQ(r.records[1].type, LogRecord::Type::kWheel);
+  EXPECT_EQ(r.records[1].wheel.left_pulses, -5.0);
+  EXPECT_EQ(r.records[1].wheel.right_pulses, 7.0);
 }
 
 TEST_F(Csv, AColumnTheMapNamesThatIsNotThereIsDamageNamedByLine) {

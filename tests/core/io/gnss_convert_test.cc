@@ -94,10 +94,10 @@ TEST_F(GnssConvert, MergesTheFixesIntoTheImuLogInTimeOrderAndDropsItsOwnGnss) {
   EXPECT_EQ(log.records[4].t(), kT0 + 0.5);
   EXPECT_EQ(log.records[6].gnss.t, kT0 + 0.75);
   EXPECT_EQ(log.records[6].gnss.sigma_enu, Vec3(0.02, 0.01, 0.03));
-  EXPECT_EQ(log.records[7].gvel.v_enu, Vec3(0.25, 0.5, -0.125));
-  EXPECT_EQ(log.records[7].gvel.sigma_enu, Vec3(0.02, 0.01, 0.03));
-  EXPECT_EQ(log.records[1].odom.left_pulses, 10.0);
-  EXPECT_EQ(log.records[1].odom.right_pulses, -11.0);
+  EXPECT_EQ(log.records[7].gnss_velocity.v_enu, Vec3(0.25, 0.5, -0.125));
+  EXPECT_EQ(log.records[7].gnss_velocity.sigma_enu, Vec3(0.02, 0.01, 0.03));
+  EXPECT_EQ(log.records[1].wheel.left_pulses, 10.0);
+  EXPECT_EQ(log.records[1].wheel.right_pulses, -11.0);
   EXPECT_EQ(c.imu.dropped_gnss, 1u);
   EXPECT_EQ(c.imu.dropped_gvel, 1u);
   EXPECT_EQ(c.written[0], 13u);

@@ -67,11 +67,11 @@ TEST_F(LogReaderTest, ReadsAllTypesWithValuesAndLineNumbers) {
   EXPECT_EQ(imu.t(), 1.0);
   EXPECT_EQ(imu.imu.gyro, Vec3(0.01, -0.02, 0.03));
   EXPECT_EQ(imu.imu.acc, Vec3(0.1, -0.2, 9.8));
-  const LogRecord& odom = r.records[1];
-  EXPECT_EQ(odom.type, LogRecord::Type::kOdom);
-  EXPECT_EQ(odom.line, 2u);
-  EXPECT_EQ(odom.odom.left_pulses, 10.0);
-  EXPECT_EQ(odom.odom.right_pulses, -12.0);
+  const LogRecord& wheel = r.records[1];
+  EXPECT_EQ(wheel.type, LogRecord::Type::kWheel);
+  EXPECT_EQ(wheel.line, 2u);
+  EXPECT_EQ(wheel.wheel.left_pulses, 10.0);
+  EXPECT_EQ(wheel.wheel.right_pulses, -12.0);
   const GnssRecord& g = r.records[2].gnss;
   EXPECT_EQ(r.records[2].type, LogRecord::Type::kGnss);
   EXPECT_EQ(g.lat_deg, 31.5);
@@ -92,7 +92,7 @@ TEST_F(LogReaderTest, ReadsAllTypesWithValuesAndLineNumbers) {
   EXPECT_EQ(g3.heading_deg, 0.0);
   EXPECT_EQ(r.stats.lines, 5u);
   EXPECT_EQ(r.stats.imu, 1u);
-  EXPECT_EQ(r.stats.odom, 1u);
+  EXPECT_EQ(r.stats.wheel, 1u);
   EXPECT_EQ(r.stats.gnss, 3u);
   EXPECT_EQ(r.stats.total_skipped(), 0u);
   EXPECT_TRUE(r.stats.examples.empty());
@@ -101,13 +101,13 @@ TEST_F(LogReaderTest, ReadsAllTypesWithValuesAndLineNumbers) {
 TEST_F(LogReaderTest, GnssVelocityWithAndWithoutSigma) {
   const ReadResult r = ReadAll(Write("log.txt", Imu("1.0") + "\nGVEL 1.0 3.5 -1.25 0.5\nGVEL 2.0 1 2 3 0.1 0.2 0.3\n"));
   ASSERT_EQ(r.records.size(), 3u);
-  EXPECT_EQ(r.stats.gvel, 2u);
-  ASSERT_EQ(r.records[1].type, LogRecord::Type::kGvel);
-  EXPECT_EQ(r.records[1].gvel.t, 1.0);
-  EXPECT_EQ(r.records[1].gvel.v_enu, Vec3(3.5, -1.25, 0.5));
-  EXPECT_FALSE(r.records[1].gvel.has_sigma);
-  EXPECT_TRUE(r.records[2].gvel.has_sigma);
-  EXPECT_EQ(r.records[2].gvel.sigma_enu, Vec3(0.1, 0.2, 0.3));
+  EXPECT_EQ(r.stats.gnss_velocity, 2u);
+  ASSERT_EQ(r.records[1].type, LogRecord::Type::kGnssVelocity);
+  EXPECT_EQ(r.records[1].gnss_velocity.t, 1.0);
+  EXPECT_EQ(r.records[1].gnss_velocity.v_enu, Vec3(3.5, -1.25, 0.5));
+  EXPECT_FALSE(r.records[1].gnss_velocity.has_sigma);
+  EXPECT_TRUE(r.records[2].gnss_velocity.has_sigma);
+  EXPECT_EQ(r.records[2].gnss_velocity.sigma_enu, Vec3(0.1, 0.2, 0.3));
   EXPECT_EQ(r.records[2].line, 3u);
 }
 
@@ -127,7 +127,7 @@ TEST_F(LogReaderTest, CommentsBlankLinesCrlfTabsAndWhitespace) {
   EXPECT_EQ(r.records[0].line, 4u);
   EXPECT_EQ(r.records[0].imu.acc.z(), 9.8);
   EXPECT_EQ(r.records[1].line, 5u);
-  EXPECT_EQ(r.records[1].odom.right_pulses, -12.0);
+  EXPECT_EQ(r.records[1].wheel.right_pulses, -12.0);
   EXPECT_EQ(r.records[2].line, 7u);
   EXPECT_TRUE(r.records[2].gnss.heading_valid);
   EXPECT_EQ(r.stats.lines, 9u);
@@ -648,7 +648,7 @@ TEST(LogReaderParseLogLineTest, ClassifiesLinesWithoutTheFile) {
   EXPECT_EQ(ParseLogLine("", &record, &issue), LineParse::kBlank);
   EXPECT_EQ(ParseLogLine("  # only a comment\r", &record, &issue), LineParse::kBlank);
   ASSERT_EQ(ParseLogLine("ODOM 5 1 2\r", &record, &issue), LineParse::kRecord);
-  EXPECT_EQ(record.type, LogRecord::Type::kOdom);
+  EXPECT_EQ(record.type, LogRecord::Type::kWheel);
   EXPECT_EQ(record.t(), 5.0);
   ASSERT_EQ(ParseLogLine("GNSS 6 1 2 3 4 1", &record, &issue), LineParse::kRecord);
   EXPECT_EQ(record.t(), 6.0);
@@ -674,7 +674,7 @@ TEST(LogReaderCheckLogRecordTest, SameRulesAsALine) {
     EXPECT_EQ(record.imu.gyro, parsed.imu.gyro);
     EXPECT_EQ(record.gnss.heading_deg, parsed.gnss.heading_deg);
     EXPECT_EQ(record.gnss.sigma_enu, parsed.gnss.sigma_enu);
-    EXPECT_EQ(record.gvel.v_enu, parsed.gvel.v_enu);
+    EXPECT_EQ(record.gnss_velocity.v_enu, parsed.gnss_velocity.v_enu);
   }
   record = {};
   record.type = LogRecord::Type::kGnss;

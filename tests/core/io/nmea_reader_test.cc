@@ -90,8 +90,8 @@ TEST_F(Nmea, GgaWithRmcsDateIsAFixOnGpsTimeWithItsEllipsoidalHeight) {
   EXPECT_FALSE(g.heading_valid);
   EXPECT_EQ(g.sigma_enu, Vec3(2.0, 2.0, 4.0));  // no GST: HDOP 1.0 × single's 2 m, up 4 m
   EXPECT_EQ(r.stats.leap_seconds.at(18), 2u);
-  const GvelRecord& v = r.records[1].gvel;
-  EXPECT_EQ(r.records[1].type, LogRecord::Type::kGvel);
+  const GnssVelocityRecord& v = r.records[1].gnss_velocity;
+  EXPECT_EQ(r.records[1].type, LogRecord::Type::kGnssVelocity);
   EXPECT_EQ(v.t, kWalkGps);
   EXPECT_EQ(v.v_enu, Vec3(0.0, 0.04 * kKnot, 0.0));
   EXPECT_EQ(v.sigma_enu, Vec3(0.1, 0.1, 0.5));
@@ -131,7 +131,7 @@ TEST_F(Nmea, VtgSpeedAndCourseBecomeAGvelWithVerticalSigmaForAGrade) {
   const Read r =
       ReadText(Rmc("173021.75", "280825", "", "") + Gga("173021.75") + S("GNVTG,90.0,T,,M,19.438,N,36.000,K,A"));
   ASSERT_EQ(r.records.size(), 2u);
-  const GvelRecord& v = r.records[1].gvel;
+  const GnssVelocityRecord& v = r.records[1].gnss_velocity;
   EXPECT_NEAR(v.v_enu.x(), 10.0, 1e-12);  // 36 km/h east
   EXPECT_NEAR(v.v_enu.y(), 0.0, 1e-12);
   EXPECT_EQ(v.v_enu.z(), 0.0);

@@ -144,8 +144,8 @@ TEST_F(RtklibPos, RotatesEcefSigmaIntoEnuAtThePoint) {
       "sdxy(m)  sdyz(m)  sdzx(m) age(s)  ratio    vx(m/s)    vy(m/s)    vz(m/s)\n" +
       std::string(line));
   ASSERT_EQ(r.records.size(), 2u);
-  EXPECT_TRUE(r.records[1].gvel.v_enu.isApprox(Vec3(1.0, 2.0, 0.5), 1e-8)) << r.records[1].gvel.v_enu.transpose();
-  EXPECT_FALSE(r.records[1].gvel.has_sigma);
+  EXPECT_TRUE(r.records[1].gnss_velocity.v_enu.isApprox(Vec3(1.0, 2.0, 0.5), 1e-8)) << r.records[1].gnss_velocity.v_enu.transpose();
+  EXPECT_FALSE(r.records[1].gnss_velocity.has_sigma);
   const GnssRecord& g = r.records[0].gnss;
   EXPECT_NEAR(g.lat_deg, lat, 1e-10);
   EXPECT_NEAR(g.lon_deg, lon, 1e-10);
@@ -179,13 +179,13 @@ TEST_F(RtklibPos, VelocityColumnsBecomeGvelRecordsAfterTheirFix) {
                Line(0).substr(0, Line(0).size() - 1) +
                "   -0.01042    0.01309    0.01111   0.11605  0.09911  0.26458  0.01401 -0.03757 -0.07552\n");
   ASSERT_EQ(r.records.size(), 2u);
-  EXPECT_EQ(r.records[1].type, LogRecord::Type::kGvel);
-  const GvelRecord& v = r.records[1].gvel;
+  EXPECT_EQ(r.records[1].type, LogRecord::Type::kGnssVelocity);
+  const GnssVelocityRecord& v = r.records[1].gnss_velocity;
   EXPECT_EQ(v.t, kWalkGps);
   EXPECT_EQ(v.v_enu, Vec3(0.01309, -0.01042, 0.01111));
   ASSERT_TRUE(v.has_sigma);
   EXPECT_EQ(v.sigma_enu, Vec3(0.09911, 0.11605, 0.26458));
-  EXPECT_EQ(r.stats.records[static_cast<int>(LogRecord::Type::kGvel)], 1u);
+  EXPECT_EQ(r.stats.records[static_cast<int>(LogRecord::Type::kGnssVelocity)], 1u);
 }
 
 TEST_F(RtklibPos, KeepsEveryQualityWithItsSigmaAndDropsWhatIsBelowMinQuality) {

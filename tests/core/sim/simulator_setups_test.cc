@@ -42,10 +42,10 @@ bool SameImu(const ImuSample& a, const ImuSample& b) { return a.t == b.t && a.gy
 
 // Bit for bit, whatever the type.
 bool SameRecord(const SimRecord& a, const SimRecord& b) {
-  return a.type == b.type && a.t() == b.t() && SameImu(a.imu, b.imu) && a.odom.left_pulses == b.odom.left_pulses &&
-         a.odom.right_pulses == b.odom.right_pulses && a.gnss.lat_deg == b.gnss.lat_deg &&
+  return a.type == b.type && a.t() == b.t() && SameImu(a.imu, b.imu) && a.wheel.left_pulses == b.wheel.left_pulses &&
+         a.wheel.right_pulses == b.wheel.right_pulses && a.gnss.lat_deg == b.gnss.lat_deg &&
          a.gnss.lon_deg == b.gnss.lon_deg && a.gnss.alt_m == b.gnss.alt_m && a.gnss.heading_deg == b.gnss.heading_deg &&
-         a.gnss.heading_valid == b.gnss.heading_valid && a.gvel.v_enu == b.gvel.v_enu;
+         a.gnss.heading_valid == b.gnss.heading_valid && a.gnss_velocity.v_enu == b.gnss_velocity.v_enu;
 }
 
 std::vector<SimRecord> Without(const std::vector<SimRecord>& all, Type type) {
@@ -88,31 +88,31 @@ TEST(SimGvel, EveryFixHasAVelocityRecordRightAfterIt) {
   options.gnss_outages = {{10.0, 5.0}};
   options.gnss_velocity_sigma = Vec3(0.03, 0.04, 0.08);
   const std::vector<SimRecord> all = RunAll(options);
-  size_t gnss = 0, gvel = 0;
+  size_t gnss = 0, gnss_velocity = 0;
   for (size_t i = 0; i < all.size(); ++i) {
     if (all[i].type == Type::kGnss) {
       ++gnss;
       ASSERT_LT(i + 1, all.size());
-      EXPECT_EQ(all[i + 1].type, Type::kGvel) << all[i].t();
+      EXPECT_EQ(all[i + 1].type, Type::kGnssVelocity) << all[i].t();
       EXPECT_EQ(all[i + 1].t(), all[i].t());
-    } else if (all[i].type == Type::kGvel) {
-      ++gvel;
+    } else if (all[i].type == Type::kGnssVelocity) {
+      ++gnss_velocity;
       ASSERT_GT(i, 0u);
       EXPECT_EQ(all[i - 1].type, Type::kGnss);
-      EXPECT_TRUE(all[i].gvel.has_sigma);
-      EXPECT_EQ(all[i].gvel.sigma_enu, options.gnss_velocity_sigma);
+      EXPECT_TRUE(all[i].gnss_velocity.has_sigma);
+      EXPECT_EQ(all[i].gnss_velocity.sigma_enu, options.gnss_velocity_sigma);
       const double s = all[i].t() - options.start_time;
       EXPECT_FALSE(s > 10.0 - 1e-4 && s < 15.0 - 1e-4) << s;  // the outage holds for GVEL too
     }
   }
   EXPECT_EQ(gnss, 601u - 50u);
-  EXPECT_EQ(gvel, gnss);
+  EXPECT_EQ(gnss_velocity, gnss);
 
   // σ = 0: no GVEL, and every other record unchanged (GVEL draws from its own stream).
   options.gnss_velocity_sigma.setZero();
   const std::vector<SimRecord> none = RunAll(options);
-  EXPECT_TRUE(OfType(none, Type::kGvel).empty());
-  const std::vector<SimRecord> rest = Without(all, Type::kGvel);
+  EXPECT_TRUE(OfType(none, Type::kGnssVelocity).empty());
+  const std::vector<SimRecord> rest = Without(all, Type::kGnssVelocity);
   ASSERT_EQ(rest.size(), none.size());
   for (size_t i = 0; i < rest.size(); ++i) ASSERT_TRUE(SameRecord(rest[i], none[i])) << i;
 }
@@ -135,15 +135,15 @@ TEST(SimGvel, NoiseFreeRecordsAreTheAntennaVelocity) {
     int checked = 0;
     SimRecord r;
     while (sim.Next(&r)) {
-      if (r.type != Type::kGvel) continue;
-      const double s = r.gvel.t - options.start_time;
+      if (r.type != Type::kGnssVelocity) continue;
+      const double s = r.gnss_velocity.t - options.start_time;
       if (s < 1e-3 || s > sim.truth().duration() - 1e-3) continue;  // differences need both sides
       const Vec3 v_ant_w = AntennaVelocityW(sim.truth(), s, options.lever_b);
       const TruthState x = sim.truth().AtElapsed(s);
       const Vec3 p_ant_w = x.p_wb + x.q_wb * options.lever_b;
       const Mat3 R_w_l = rotating ? frame.RotationFromLocalEnu(frame.ToGeodetic(p_ant_w)) : Mat3::Identity();
-      max_err = std::max(max_err, (r.gvel.v_enu - R_w_l.transpose() * v_ant_w).norm());
-      max_rotation_effect = std::max(max_rotation_effect, (r.gvel.v_enu - v_ant_w).norm());
+      max_err = std::max(max_err, (r.gnss_velocity.v_enu - R_w_l.transpose() * v_ant_w).norm());
+      max_rotation_effect = std::max(max_rotation_effect, (r.gnss_velocity.v_enu - v_ant_w).norm());
       ++checked;
     }
     EXPECT_GT(checked, 290);
@@ -165,10 +165,10 @@ TEST(SimGvel, NoiseMatchesSigma) {
   int n = 0;
   SimRecord r;
   while (sim.Next(&r)) {
-    if (r.type != Type::kGvel) continue;
+    if (r.type != Type::kGnssVelocity) continue;
     const TruthState x = sim.truth().AtElapsed(static_cast<double>(n) / options.gnss_rate);
     const Vec3 v_ant_w = x.v_w + x.q_wb * x.omega_b.cross(options.lever_b);
-    sum_sq += (r.gvel.v_enu - v_ant_w).cwiseAbs2();
+    sum_sq += (r.gnss_velocity.v_enu - v_ant_w).cwiseAbs2();
     ++n;
   }
   ASSERT_EQ(n, 1201);
@@ -183,11 +183,11 @@ TEST(SimGvel, WrittenAfterItsFixWithSigmaColumns) {
   options.gnss_velocity_sigma = Vec3(0.05, 0.05, 0.1);
   const std::string dir = test::MakeTempDir("sim_gvel");
   const SimulationResult result = Simulate(options, dir);
-  EXPECT_EQ(result.gvel, 37u);
+  EXPECT_EQ(result.gnss_velocity, 37u);
   EXPECT_EQ(result.gnss, 37u);
   const std::vector<std::string> log = Lines(test::ReadFile(dir + "/log.txt"));
   EXPECT_NE(log.at(1).find("| GVEL t ve vn vu se sn su"), std::string::npos) << log[1];
-  const std::vector<SimRecord> gvel = OfType(RunAll(options), Type::kGvel);
+  const std::vector<SimRecord> gnss_velocity = OfType(RunAll(options), Type::kGnssVelocity);
   size_t n = 0;
   for (size_t i = 0; i < log.size(); ++i) {
     const std::vector<std::string> f = Fields(log[i]);
@@ -195,14 +195,14 @@ TEST(SimGvel, WrittenAfterItsFixWithSigmaColumns) {
     ASSERT_EQ(f.size(), 8u) << log[i];
     EXPECT_EQ(Fields(log[i - 1]).at(0), "GNSS");
     EXPECT_EQ(Fields(log[i - 1]).at(1), f[1]);
-    const GvelRecord& g = gvel.at(n++).gvel;
+    const GnssVelocityRecord& g = gnss_velocity.at(n++).gnss_velocity;
     EXPECT_NEAR(std::stod(f[1]), g.t, 1e-6);
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(std::stod(f[2 + k]), g.v_enu[k], 5.001e-5);
       EXPECT_EQ(std::stod(f[5 + k]), options.gnss_velocity_sigma[k]);
     }
   }
-  EXPECT_EQ(n, gvel.size());
+  EXPECT_EQ(n, gnss_velocity.size());
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -247,20 +247,20 @@ TEST(SimReverse, BacksUpFacingForwardWithoutSideSlip) {
 
 TEST(SimReverse, WheelPulsesAreNegativeWhenBackingUp) {
   const SimOptions options = ReverseDrive();
-  const std::vector<SimRecord> odom = OfType(RunAll(options), Type::kOdom);
+  const std::vector<SimRecord> wheel = OfType(RunAll(options), Type::kWheel);
   const TruthTrajectory truth(options);
   const double dt = 1.0 / options.wheel_rate;
   const double pulse_speed = WheelSpeedFromPulses(1.0, options.wheel_radius, options.pulses_per_rev, dt);
   int negative = 0;
-  for (const SimRecord& r : odom) {
-    const double s1 = r.odom.t - options.start_time;
+  for (const SimRecord& r : wheel) {
+    const double s1 = r.wheel.t - options.start_time;
     const Vec2 mean = truth.IntegrateSpeedAndYawRate(s1 - dt, s1) / dt;  // signed
-    const double left = WheelSpeedFromPulses(r.odom.left_pulses, options.wheel_radius, options.pulses_per_rev, dt);
-    const double right = WheelSpeedFromPulses(r.odom.right_pulses, options.wheel_radius, options.pulses_per_rev, dt);
+    const double left = WheelSpeedFromPulses(r.wheel.left_pulses, options.wheel_radius, options.pulses_per_rev, dt);
+    const double right = WheelSpeedFromPulses(r.wheel.right_pulses, options.wheel_radius, options.pulses_per_rev, dt);
     EXPECT_NEAR(0.5 * (left + right) / options.wheel_scale, mean.x(), pulse_speed / options.wheel_scale + 1e-9);
     if (truth.AtElapsed(s1).reverse && mean.x() < -0.5) {
-      EXPECT_LT(r.odom.left_pulses, 0.0) << s1;
-      EXPECT_LT(r.odom.right_pulses, 0.0) << s1;
+      EXPECT_LT(r.wheel.left_pulses, 0.0) << s1;
+      EXPECT_LT(r.wheel.right_pulses, 0.0) << s1;
       ++negative;
     }
   }
@@ -339,15 +339,15 @@ TEST(SimLogStart, RecordsStartAtTheCutAndAreThoseOfTheWholeDrive) {
   EXPECT_NEAR(cut.front().t(), t_cut, 1e-6);
   EXPECT_GT(cut.front().truth.v_w.norm(), 5.0);  // driving
   EXPECT_NEAR(OfType(cut, Type::kGnss).front().t(), options.start_time + 12.4, 1e-6);
-  EXPECT_NEAR(OfType(cut, Type::kGvel).front().t(), options.start_time + 12.4, 1e-6);
+  EXPECT_NEAR(OfType(cut, Type::kGnssVelocity).front().t(), options.start_time + 12.4, 1e-6);
   // Pulses over (12.3, 12.4] straddle the cut: the first encoder record counts over (12.4, 12.5].
-  EXPECT_NEAR(OfType(cut, Type::kOdom).front().t(), options.start_time + 12.5, 1e-6);
+  EXPECT_NEAR(OfType(cut, Type::kWheel).front().t(), options.start_time + 12.5, 1e-6);
 
   // The same records, bit for bit, as the whole drive's from the cut on (bias walks, pulse remainders and
   // the correlated GNSS error all ran before it).
   std::vector<SimRecord> expected;
   for (const SimRecord& r : whole) {
-    const bool odom_straddles = r.type == Type::kOdom && r.t() < t_cut + 0.1 - 1e-6;
+    const bool odom_straddles = r.type == Type::kWheel && r.t() < t_cut + 0.1 - 1e-6;
     if (r.t() >= t_cut - 1e-6 && !odom_straddles) expected.push_back(r);
   }
   ASSERT_EQ(cut.size(), expected.size());

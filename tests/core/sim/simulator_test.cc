@@ -387,18 +387,18 @@ TEST(SimGnss, OutliersAtConfiguredRateAndMagnitude) {
 
 TEST(SimWheel, PulsesGiveTruthSpeedWithinQuantisation) {
   SimOptions options = NoiseFree(Drive());
-  const std::vector<SimRecord> odom = OfType(RunAll(options), SimRecord::Type::kOdom);
-  ASSERT_EQ(odom.size(), 600u);
+  const std::vector<SimRecord> wheel = OfType(RunAll(options), SimRecord::Type::kWheel);
+  ASSERT_EQ(wheel.size(), 600u);
   const TruthTrajectory truth(options);
   const double dt = 1.0 / options.wheel_rate;
   // One pulse (the most the carried remainder can shift a count) as a speed.
   const double pulse_speed = WheelSpeedFromPulses(1.0, options.wheel_radius, options.pulses_per_rev, dt);
   double max_err = 0.0;
-  for (const SimRecord& r : odom) {
-    const double left = WheelSpeedFromPulses(r.odom.left_pulses, options.wheel_radius, options.pulses_per_rev, dt);
-    const double right = WheelSpeedFromPulses(r.odom.right_pulses, options.wheel_radius, options.pulses_per_rev, dt);
-    EXPECT_EQ(r.odom.left_pulses, std::round(r.odom.left_pulses));
-    const double s1 = r.odom.t - options.start_time;
+  for (const SimRecord& r : wheel) {
+    const double left = WheelSpeedFromPulses(r.wheel.left_pulses, options.wheel_radius, options.pulses_per_rev, dt);
+    const double right = WheelSpeedFromPulses(r.wheel.right_pulses, options.wheel_radius, options.pulses_per_rev, dt);
+    EXPECT_EQ(r.wheel.left_pulses, std::round(r.wheel.left_pulses));
+    const double s1 = r.wheel.t - options.start_time;
     // The counts measure the mean speed over (t − Δt, t].
     const Vec2 mean = truth.IntegrateSpeedAndYawRate(s1 - dt, s1) / dt;
     max_err = std::max(max_err, std::abs(0.5 * (left + right) / options.wheel_scale - mean.x()));
@@ -413,20 +413,20 @@ TEST(SimWheel, PulsesGiveTruthSpeedWithinQuantisation) {
 // the noise shows.
 TEST(SimWheel, ParkedWheelsCountNothing) {
   const SimOptions options = Drive();
-  const std::vector<SimRecord> odom = OfType(RunAll(options), SimRecord::Type::kOdom);
+  const std::vector<SimRecord> wheel = OfType(RunAll(options), SimRecord::Type::kWheel);
   const TruthTrajectory truth(options);
   const double dt = 1.0 / options.wheel_rate;
   int parked = 0, rolling = 0;
   double sum_sq = 0.0;
-  for (const SimRecord& r : odom) {
-    const double s1 = r.odom.t - options.start_time;
+  for (const SimRecord& r : wheel) {
+    const double s1 = r.wheel.t - options.start_time;
     const double distance = truth.IntegrateSpeedAndYawRate(s1 - dt, s1).x();
     if (distance == 0.0) {
-      EXPECT_EQ(r.odom.left_pulses, 0.0);
-      EXPECT_EQ(r.odom.right_pulses, 0.0);
+      EXPECT_EQ(r.wheel.left_pulses, 0.0);
+      EXPECT_EQ(r.wheel.right_pulses, 0.0);
       ++parked;
     } else if (distance > 0.1) {
-      const double v = WheelSpeedFromPulses(0.5 * (r.odom.left_pulses + r.odom.right_pulses), options.wheel_radius,
+      const double v = WheelSpeedFromPulses(0.5 * (r.wheel.left_pulses + r.wheel.right_pulses), options.wheel_radius,
                                             options.pulses_per_rev, dt);
       sum_sq += std::pow(v - options.wheel_scale * distance / dt, 2);
       ++rolling;
@@ -446,7 +446,7 @@ TEST(SimStream, TimeOrderedWithExpectedCounts) {
   const std::vector<SimRecord> all = RunAll(Drive());
   EXPECT_EQ(OfType(all, SimRecord::Type::kImu).size(), 6001u);
   EXPECT_EQ(OfType(all, SimRecord::Type::kGnss).size(), 61u);
-  EXPECT_EQ(OfType(all, SimRecord::Type::kOdom).size(), 600u);
+  EXPECT_EQ(OfType(all, SimRecord::Type::kWheel).size(), 600u);
   for (size_t i = 1; i < all.size(); ++i) {
     ASSERT_LE(all[i - 1].t(), all[i].t());
     // Ties: the IMU sample comes first, so a filter has propagated to t before it updates at t.
@@ -466,8 +466,8 @@ TEST(SimRandom, ReproducibleFromSeed) {
   for (size_t i = 0; i < a.size(); ++i) {
     ASSERT_EQ(a[i].type, b[i].type);
     EXPECT_TRUE(SameImu(a[i].imu, b[i].imu));
-    EXPECT_EQ(a[i].odom.left_pulses, b[i].odom.left_pulses);
-    EXPECT_EQ(a[i].odom.right_pulses, b[i].odom.right_pulses);
+    EXPECT_EQ(a[i].wheel.left_pulses, b[i].wheel.left_pulses);
+    EXPECT_EQ(a[i].wheel.right_pulses, b[i].wheel.right_pulses);
     EXPECT_EQ(a[i].gnss.lat_deg, b[i].gnss.lat_deg);
     EXPECT_EQ(a[i].gnss.heading_deg, b[i].gnss.heading_deg);
   }
@@ -555,7 +555,7 @@ TEST(SimFiles, SimulateWritesParsableLogAndTruth) {
   const SimulationResult result = Simulate(options, dir);
   EXPECT_EQ(result.imu, 1801u);
   EXPECT_EQ(result.gnss, 19u);
-  EXPECT_EQ(result.odom, 180u);
+  EXPECT_EQ(result.wheel, 180u);
   EXPECT_DOUBLE_EQ(result.duration, 18.0);
 
   const std::vector<std::string> log = Lines(test::ReadFile(dir + "/log.txt"));
@@ -582,9 +582,9 @@ TEST(SimFiles, SimulateWritesParsableLogAndTruth) {
       }
     } else if (f[0] == "ODOM") {
       ASSERT_EQ(f.size(), 4u) << line;
-      ASSERT_EQ(r.type, SimRecord::Type::kOdom);
-      EXPECT_EQ(std::stod(f[2]), r.odom.left_pulses);
-      EXPECT_EQ(std::stod(f[3]), r.odom.right_pulses);
+      ASSERT_EQ(r.type, SimRecord::Type::kWheel);
+      EXPECT_EQ(std::stod(f[2]), r.wheel.left_pulses);
+      EXPECT_EQ(std::stod(f[3]), r.wheel.right_pulses);
     } else {
       ASSERT_EQ(f[0], "GNSS");
       ASSERT_EQ(f.size(), 10u) << line;

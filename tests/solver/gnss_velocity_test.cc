@@ -33,12 +33,12 @@ test::RecordHook WithGvel(double sigma_v, const Vec3& lever_b) {
     if (rec.type == SimRecord::Type::kImu) *omega_b = rec.imu.gyro - rec.truth.bg;
     if (rec.type != SimRecord::Type::kGnss) return;
     std::normal_distribution<double> n(0.0, sigma_v);
-    GvelRecord g;
+    GnssVelocityRecord g;
     g.t = rec.gnss.t;
     g.v_enu = rec.truth.v_w + rec.truth.q_wb * omega_b->cross(lever_b) + Vec3(n(*rng), n(*rng), n(*rng));
     g.has_sigma = true;
     g.sigma_enu = Vec3::Constant(sigma_v);
-    session.AddGvel(g);
+    session.AddGnssVelocity(g);
   };
 }
 

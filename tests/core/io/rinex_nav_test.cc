@@ -165,6 +165,18 @@ TEST(RinexNav, StateVectorRecords) {
   }
 }
 
+TEST(RinexNav, GlonassHasFiveLinesFromVersion305) {
+  std::vector<double> f(19);
+  for (size_t n = 0; n < f.size(); ++n) f[n] = static_cast<double>(n) + 0.5;
+  const RinexNav nav = Read(WriteTemp(NavHeader(H("    18", "LEAP SECONDS"), "     3.05") +
+                                      Record("R07", " 2025 08 28 17 15 00", f) +
+                                      Record("G05", " 2025 08 28 18 00 00", KeplerFields())));
+  EXPECT_EQ(nav.file.total_skipped(), 0u) << FormatIssueCounts("skipped", nav.file.skipped, nav.file.issues);
+  ASSERT_EQ(nav.state.size(), 1u);
+  EXPECT_EQ(nav.state[0].age_or_iodn, 14.5);
+  EXPECT_EQ(nav.kepler.size(), 1u);
+}
+
 TEST(RinexNav, RefusesHeadersItCannotRead) {
   auto refused = [](const std::string& text, const std::string& where_what) {
     const std::string path = WriteTemp(text);
@@ -220,6 +232,14 @@ std::vector<DamageCase> DamageCases() {
       {"truncated_at_end", h + g2 + cut, "truncated", r2, 1},
       {"truncated_mid_field", h + g2 + g.substr(0, g.size() - 10), "truncated", r2, 1},
       {"bad_leap_seconds", NavHeader(H("   x18", "LEAP SECONDS")) + g2, "bad_number", kNavHeaderLines, 1},
+      {"bad_iono_parameter",
+       NavHeader(H("BDSA    .1118D-07   .00x0D+00  -.5960D-07   .0000D+00", "IONOSPHERIC CORR")) + g2, "bad_number",
+       kNavHeaderLines, 1},
+      {"blank_iono_parameter", NavHeader(H("GPSB    .1118D-07", "IONOSPHERIC CORR")) + g2, "missing_fields",
+       kNavHeaderLines, 1},
+      {"bad_time_correction",
+       NavHeader(H("GPUT   .9313225746D-09  .000000000D+00 3456x0 2381", "TIME SYSTEM CORR")) + g2, "bad_number",
+       kNavHeaderLines, 1},
   };
 }
 

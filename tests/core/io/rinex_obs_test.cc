@@ -345,6 +345,11 @@ std::vector<DamageCase> DamageCases() {
        kHeaderLines + 7, 2},
       {"truncated_last_satellite", h + three.substr(0, three.size() - 5), "truncated", kHeaderLines + 9, 3},
       {"bad_interval_line", Replace(h, "     0.250", "     0.2x0") + Epoch(0), "bad_number", 7, 1},
+      {"bad_approx_position", Replace(h, "-4717214.8258", "-4717214.82x8") + Epoch(0), "bad_number", 2, 1},
+      {"blank_antenna_delta",
+       Replace(h, "1.2500        0.0000        0.0000", "1.2500" + std::string(28, ' ')) + Epoch(0), "missing_fields",
+       3, 1},
+      {"bad_leap_seconds", Header("GPS", H("    1x", "LEAP SECONDS")) + Epoch(0), "bad_number", 8, 1},
   };
 }
 

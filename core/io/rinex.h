@@ -291,6 +291,28 @@ std::string_view Trim(std::string_view s);
 bool IsBlank(std::string_view s);
 // An optionally signed decimal integer, blanks around it allowed; false for a blank or anything else.
 bool ParseInt(std::string_view field, int* value);
+// One line read ahead and put back for the next read (a record ends where the next one begins).
+class HeldLine {
+ public:
+  bool Take(TextLine* line) {
+    if (!held_) return false;
+    held_ = false;
+    *line = line_;
+    line->text = text_;
+    return true;
+  }
+  void Put(const TextLine& line) {
+    text_.assign(line.text);
+    line_ = line;
+    held_ = true;
+  }
+  bool holds() const { return held_; }
+
+ private:
+  bool held_ = false;
+  std::string text_;  // the line's own copy: the source's buffer moves on
+  TextLine line_;
+};
 // The header label (columns 61-80, trimmed).
 inline std::string_view Label(std::string_view line) { return Trim(Column(line, 61, 20)); }
 // The calendar epoch of a navigation record or TIME OF FIRST OBS-like fields: year, month, day, hour,

@@ -49,20 +49,8 @@ class NavParser {
   }
 
  private:
-  bool Get(TextLine* line) {
-    if (held_) {
-      held_ = false;
-      *line = held_line_;
-      line->text = held_text_;
-      return true;
-    }
-    return lines_.Next(line);
-  }
-  void PutBack(const TextLine& line) {
-    held_text_.assign(line.text);
-    held_line_ = line;
-    held_ = true;
-  }
+  bool Get(TextLine* line) { return held_.Take(line) || lines_.Next(line); }
+  void PutBack(const TextLine& line) { held_.Put(line); }
 
   void ReadHeader();
   void HeaderLine(const TextLine& line, std::string_view label);
@@ -73,9 +61,7 @@ class NavParser {
 
   RinexNav* nav_;
   InputLines lines_;
-  bool held_ = false;
-  std::string held_text_;
-  TextLine held_line_;
+  rinex_internal::HeldLine held_;
 };
 
 void NavParser::ReadHeader() {

@@ -44,20 +44,8 @@ class RinexObsReader::Impl {
   bool Next(RinexObsEpoch* epoch);
 
  private:
-  bool Get(TextLine* line) {
-    if (held_) {
-      held_ = false;
-      *line = held_line_;
-      line->text = held_text_;
-      return true;
-    }
-    return lines_.Next(line);
-  }
-  void PutBack(const TextLine& line) {
-    held_text_.assign(line.text);
-    held_line_ = line;
-    held_ = true;
-  }
+  bool Get(TextLine* line) { return held_.Take(line) || lines_.Next(line); }
+  void PutBack(const TextLine& line) { held_.Put(line); }
   [[noreturn]] void Refuse(uint64_t line, const std::string& message) { lines_.issues().Refuse(line, message); }
   void HeaderLine(const TextLine& line, std::string_view label);
   void ObsTypes(const TextLine& line);
@@ -70,9 +58,7 @@ class RinexObsReader::Impl {
 
   RinexObsReader* r_;
   InputLines lines_;
-  bool held_ = false;
-  std::string held_text_;
-  TextLine held_line_;
+  rinex_internal::HeldLine held_;
   // SYS / # / OBS TYPES being read: its system and the count it announced.
   bool types_open_ = false;
   GnssSystem types_system_ = GnssSystem::kGps;
@@ -342,7 +328,7 @@ bool RinexObsReader::Impl::Next(RinexObsEpoch* epoch) {
       const bool complete = SkipLines(count, flag, flag == 6 ? &stats.cycle_slip_lines : &stats.event_lines);
       ++(flag == 6 ? stats.cycle_slip_epochs : stats.event_epochs);
       if (!complete) {
-        lines_.issues().Damage(at, held_ ? kMissingFields : kTruncated,
+        lines_.issues().Damage(at, held_.holds() ? kMissingFields : kTruncated,
                                FormatText("epoch flag %d announces %d records; fewer follow", flag, count));
       }
       continue;
@@ -375,7 +361,7 @@ bool RinexObsReader::Impl::Next(RinexObsEpoch* epoch) {
     epoch->satellites.resize(kept);
     if (read < count) {
       // Cut at the end of the file or by the next epoch: the epoch is not whole, and it is not given.
-      lines_.issues().Damage(at, held_ ? kMissingFields : kTruncated,
+      lines_.issues().Damage(at, held_.holds() ? kMissingFields : kTruncated,
                              FormatText("epoch announces %d satellites, %d lines follow", count, read));
       continue;
     }

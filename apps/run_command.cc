@@ -95,7 +95,7 @@ std::string AbsolutePath(const std::string& path) {
 }
 
 // summary.json's "input": what was read and skipped.
-nlohmann::json InputJson(const ReadStats& rs, const Session& session, const nlohmann::json& session_stats,
+nlohmann::json InputJson(const ReadStats& rs, const EstimatorPipeline& session, const nlohmann::json& session_stats,
                          const api::Status& status) {
   nlohmann::json input;
   input["lines"] = rs.lines;
@@ -167,7 +167,7 @@ nlohmann::json FaultsJson(const nlohmann::json& summary, const nlohmann::json& s
 // (simulated ones and the log's own gaps, absolute times) that the comparison scores the drift over.
 nlohmann::json RunSummary(const Options& options, const RunRequest& request, const ReadStats& rs,
                           const api::Session& api_session, const Streams& streams, Clock::time_point wall_start) {
-  const Session& session = api::internal::Access::session(api_session);
+  const EstimatorPipeline& session = api::internal::Access::session(api_session);
   nlohmann::json j;
   j["gins_version"] = api::Version();
   j["mode"] = request.mode;
@@ -218,8 +218,8 @@ nlohmann::json RunSummary(const Options& options, const RunRequest& request, con
 // the summary's outage windows, and the smoother against the ESKF, into j["comparison"]; the scores
 // against the truth also into j["accuracy"] and *accuracy. Comparisons exist against the truth and against
 // the ESKF: without either (the smoother alone) there is nothing to read back.
-void AddComparison(const RunRequest& request, const Session& session, const Streams& streams, nlohmann::json* j,
-                   std::map<std::string, TrajectoryMetrics>* accuracy) {
+void AddComparison(const RunRequest& request, const EstimatorPipeline& session, const Streams& streams,
+                   nlohmann::json* j, std::map<std::string, TrajectoryMetrics>* accuracy) {
   if (!request.truth_path && !(streams.count("eskf") && streams.size() > 1)) return;
   std::vector<std::string> names;
   for (const auto& [name, s] : streams) names.push_back(name);
@@ -319,7 +319,7 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
   });
   // After what its callback uses: on an error the session (and its estimator threads) goes first.
   api::Session session(config, session_options);
-  const Session& internal = api::internal::Access::session(session);
+  const EstimatorPipeline& internal = api::internal::Access::session(session);
   // States arrive only after initialisation, when the world frame (and so the truth in it) exists.
   session.OnState([&](const api::State& state) {
     OutputStream*& out = by_stream[static_cast<size_t>(state.stream)];

@@ -21,7 +21,7 @@
 #include "core/io/log_reader.h"
 #include "gins/gins.h"
 #include "solver/estimator.h"
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 
 namespace gins {
 

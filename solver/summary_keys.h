@@ -5,7 +5,7 @@
 
 namespace gins::summary_keys {
 
-// Session::Stats() (solver/session.h), read into summary.json's "input" and "faults".
+// EstimatorPipeline::Stats() (solver/estimator_pipeline.h), read into summary.json's "input" and "faults".
 inline constexpr char kOdomIgnoredWheelDisabled[] = "odom_ignored_wheel_disabled";
 inline constexpr char kGvelUnused[] = "gvel_unused";
 inline constexpr char kImuIntervalJitter[] = "imu_interval_jitter";

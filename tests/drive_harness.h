@@ -1,4 +1,4 @@
-// End-to-end harness for the seeded drive tests: a simulated drive through one Session with both
+// End-to-end harness for the seeded drive tests: a simulated drive through one EstimatorPipeline with both
 // estimators (records may be edited or added on the way), and the accuracy of each output stream against
 // the simulator's truth over a time range.
 #pragma once
@@ -14,7 +14,7 @@
 #include "core/so3.h"
 #include "sim_feed.h"
 #include "solver/eskf.h"
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 #include "solver/smoother.h"
 
 namespace gins::test {
@@ -26,21 +26,21 @@ struct DriveRun {
   std::vector<StateEstimate> eskf_rts, batch;  // with smoothing: the two-sided streams
   bool initialized = false;
   double first_t = 0.0, init_t = 0.0;
-  nlohmann::json stats;  // Session::Stats()
+  nlohmann::json stats;  // EstimatorPipeline::Stats()
 };
 
 // Called for every simulated record before the session sees it; feed(rec) passes a record on (call it
 // zero, one or more times, e.g. to drop, edit or add records); the session is there for records the
 // simulator does not make.
 using RecordHook = std::function<void(const SimRecord& rec, const std::function<void(const SimRecord&)>& feed,
-                                      Session& session)>;
+                                      EstimatorPipeline& session)>;
 
 inline DriveRun RunDriveThroughSession(const SimOptions& sim, const EstimatorOptions& options,
                                        const RecordHook& hook = nullptr, bool with_eskf = true,
                                        bool with_smoother = true, bool with_smoothing = false) {
   DriveRun out;
   Simulator simulator(sim);
-  Session session(options);
+  EstimatorPipeline session(options);
   if (with_eskf) {
     StateCallback rts;
     if (with_smoothing) rts = [&](const StateEstimate& e) { out.eskf_rts.push_back(e); };

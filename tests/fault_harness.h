@@ -180,14 +180,14 @@ inline SimOptions FaultDrive(unsigned seed, double duration, bool keep_outage = 
 
 // A hook that drops the records for which `drop(record)` is true.
 inline RecordHook Dropping(std::function<bool(const SimRecord&)> drop) {
-  return [drop](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, Session&) {
+  return [drop](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline&) {
     if (!drop(r)) feed(r);
   };
 }
 
 // A hook that edits the records, or drops them (edit returns false).
 inline RecordHook Editing(std::function<bool(SimRecord*)> edit) {
-  return [edit](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, Session&) {
+  return [edit](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline&) {
     SimRecord e = r;
     if (edit(&e)) feed(e);
   };

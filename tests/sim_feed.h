@@ -1,11 +1,11 @@
-// Feeding a simulated drive to a Session, as the runner feeds it a log's records.
+// Feeding a simulated drive to a EstimatorPipeline, as the runner feeds it a log's records.
 #pragma once
 
 #include "core/sim/simulator.h"
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 
 namespace gins::test {
 
-inline void FeedSession(Session* session, const SimRecord& rec) { session->Add(rec); }
+inline void FeedSession(EstimatorPipeline* session, const SimRecord& rec) { session->Add(rec); }
 
 }  // namespace gins::test

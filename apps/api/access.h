@@ -7,7 +7,7 @@
 #include "config/options.h"
 #include "core/io/log_reader.h"
 #include "gins/gins.h"
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 
 namespace gins::api::internal {
 
@@ -15,7 +15,7 @@ class Access {
  public:
   static const Options& options(const Config& config);
   static Config MakeConfig(const Options& options);
-  static const ::gins::Session& session(const Session& session);
+  static const ::gins::EstimatorPipeline& session(const Session& session);
   // The internal session's Stats() and the API's own counts under "session" (as Session::StatsJson()).
   static nlohmann::json stats(const Session& session);
   static const ReadStats& read_stats(const LogReader& reader);

@@ -1,5 +1,5 @@
 // api::Session (gins/gins.h): checks each pushed measurement as the log reader checks a line, sorts it in
-// through the reorder buffer, and feeds the internal session (solver/session.h) that owns the estimators;
+// through the reorder buffer, and feeds the internal session (solver/estimator_pipeline.h) that owns the estimators;
 // their states come back through Emit, converted to the public State.
 #include <cmath>
 #include <deque>
@@ -37,7 +37,7 @@ class Session::Impl {
   bool init_timed_out() const { return !session_.initialized() && session_.elapsed() > options_.init.max_wait; }
   Status GetStatus() const;
   nlohmann::json Stats() const;
-  const ::gins::Session& session() const { return session_; }
+  const ::gins::EstimatorPipeline& session() const { return session_; }
 
  private:
   void Dispatch(const LogRecord& r);
@@ -47,7 +47,7 @@ class Session::Impl {
 
   const Options options_;
   const SessionOptions session_options_;
-  ::gins::Session session_;
+  ::gins::EstimatorPipeline session_;
   ReorderBuffer reorder_;
   // The IMU's and the wheels' stamps, regularised in arrival order (input.regularize_stamps).
   SampleClock imu_clock_, wheel_clock_;
@@ -259,7 +259,7 @@ bool Session::init_timed_out() const { return impl_->init_timed_out(); }
 Status Session::status() const { return impl_->GetStatus(); }
 std::string Session::StatsJson() const { return impl_->Stats().dump(); }
 
-const ::gins::Session& internal::Access::session(const Session& session) { return session.impl_->session(); }
+const ::gins::EstimatorPipeline& internal::Access::session(const Session& session) { return session.impl_->session(); }
 nlohmann::json internal::Access::stats(const Session& session) { return session.impl_->Stats(); }
 
 }  // namespace gins::api

@@ -21,7 +21,7 @@
 #include "core/io/number_format.h"
 #include "core/io/text_input.h"  // InputError: a truth or log that cannot be read, from Run
 #include "gins/gins.h"
-#include "solver/session.h"  // RunError: a run that cannot give a trajectory, from Run
+#include "solver/estimator_pipeline.h"  // RunError: a run that cannot give a trajectory, from Run
 
 namespace gins::python {
 namespace {

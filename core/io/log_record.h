@@ -1,7 +1,7 @@
 // A record of the log (docs/formats.md §3), the one record type below the public API: what the reader yields,
 // what the simulator generates (core/sim/simulator.h: SimRecord, with its truth), what the writer writes and
-// what the solver's Session takes (Session::Add). A switch over Type is written where a type's own code is
-// chosen (parsing, writing, dispatch), never for the time stamp.
+// what the solver's EstimatorPipeline takes (EstimatorPipeline::Add). A switch over Type is written where a
+// type's own code is chosen (parsing, writing, dispatch), never for the time stamp.
 #pragma once
 
 #include <cstdint>

@@ -9,7 +9,7 @@
 
 #include "core/sim/simulator.h"
 #include "solver/eskf.h"
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 #include "solver/smoother.h"
 #include "sim_feed.h"
 #include "test_scenarios.h"
@@ -37,7 +37,7 @@ void RunDrive(benchmark::State& state, MakeEstimator make) {
   const Options options = test::TestRunOptions(test::TestDrive(1));
   int64_t imu = 0, gnss = 0;
   for (auto _ : state) {
-    Session session(options);
+    EstimatorPipeline session(options);
     session.AddEstimator(make(options));
     for (const auto& r : records) {
       test::FeedSession(&session, r);
@@ -68,7 +68,7 @@ class EskfFixture {
   explicit EskfFixture(const Options& options = test::TestRunOptions(test::TestDrive(1))) : options_(options) {
     auto eskf = std::make_unique<Eskf>(options_, nullptr);
     eskf_ = eskf.get();
-    session_ = std::make_unique<Session>(options_);
+    session_ = std::make_unique<EstimatorPipeline>(options_);
     session_->AddEstimator(std::move(eskf));
     for (const auto& r : DriveRecords()) {
       test::FeedSession(session_.get(), r);
@@ -79,7 +79,7 @@ class EskfFixture {
 
  private:
   Options options_;
-  std::unique_ptr<Session> session_;
+  std::unique_ptr<EstimatorPipeline> session_;
   Eskf* eskf_ = nullptr;
 };
 
@@ -238,7 +238,7 @@ const StepDriveInputs& StepInputs() {
     const SimOptions sim = StepDrive();
     out.options = test::TestRunOptions(sim);
     out.start_time = sim.start_time;
-    Session session(out.options);
+    EstimatorPipeline session(out.options);
     session.AddEstimator(std::make_unique<Recorder>(&out.init, &out.inputs));
     Simulator simulator(sim);
     SimRecord r;

@@ -32,7 +32,7 @@ struct InitRun {
   std::vector<std::pair<double, double>> heading_errors_deg;  // (t, error) of every valid heading fed
 };
 
-// Feeds the initialiser the drive's records, converted as the Session converts them (world frame at the
+// Feeds the initialiser the drive's records, converted as the EstimatorPipeline converts them (world frame at the
 // simulation's origin), until it completes or the drive ends.
 InitRun Feed(const SimOptions& sim, const Options& options) {
   const double g_norm = NormalGravity(sim.origin.lat_deg, sim.origin.alt_m);

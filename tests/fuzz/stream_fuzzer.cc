@@ -1,7 +1,7 @@
 // libFuzzer target: the estimators on an arbitrary stream of well-formed records. The bytes decode into run
 // options and records the log reader could have produced (tests/fuzz/stream_format.h: IMU, ODOM, GNSS with
 // and without heading and σ, GVEL; time steps, gaps, jumps, bursts of one stamp, rate changes, jitter, and a
-// consistent vehicle with sensor faults), which go through a Session with the ESKF and the smoother (small
+// consistent vehicle with sensor faults), which go through a EstimatorPipeline with the ESKF and the smoother (small
 // window, few iterations) as `gins run` feeds them. The invariants are stream_harness.h's: no abort or
 // unexpected exception, finite states and σ, σ > 0 where written, time order. A violation aborts with its
 // description; scripts/fuzz.sh runs it as `stream`, seeds in corpus/stream/ (make_stream_seeds.cc).

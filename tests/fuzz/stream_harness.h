@@ -1,4 +1,4 @@
-// One decoded stream (stream_format.h) through a Session with both estimators, fed as `gins run` feeds a log
+// One decoded stream (stream_format.h) through a EstimatorPipeline with both estimators, fed as `gins run` feeds a log
 // (and given up like it when initialisation takes longer than init.max_wait_s), and the estimators' promises
 // checked whatever the input:
 //   - nothing aborts or throws, except RunError from Finish when the run never initialised, and RunError from
@@ -19,7 +19,7 @@
 
 #include "fuzz/stream_format.h"
 #include "solver/eskf.h"
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 #include "solver/smoother.h"
 
 namespace gins::fuzz {
@@ -92,7 +92,7 @@ inline StreamResult RunStream(const uint8_t* data, size_t size) {
       (*c)(e);
     };
   };
-  Session session(options);
+  EstimatorPipeline session(options);
   session.AddEstimator(std::make_unique<Eskf>(options, counted(&eskf)));
   session.AddEstimator(std::make_unique<Smoother>(options, counted(&final_states), counted(&online)));
   LogRecord r;

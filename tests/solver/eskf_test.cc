@@ -8,7 +8,7 @@
 #include "core/heading_model.h"
 #include "core/sim/simulator.h"
 #include "core/so3.h"
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 #include "sim_feed.h"
 #include "test_scenarios.h"
 
@@ -34,7 +34,7 @@ bool InOutage(const SimOptions& sim, double t, double after) {
 
 DriveResult RunDrive(const SimOptions& sim, const Options& options) {
   Simulator simulator(sim);
-  Session session(options);
+  EstimatorPipeline session(options);
   auto eskf_owned = std::make_unique<Eskf>(options, nullptr);
   Eskf* eskf = eskf_owned.get();
   session.AddEstimator(std::move(eskf_owned));
@@ -138,7 +138,7 @@ TEST(EskfEndToEnd, CovarianceIntervalMatchesPerSample) {
       options.eskf.covariance_interval = interval;
       std::vector<StateEstimate> states;
       Simulator simulator(sim);
-      Session session(options);
+      EstimatorPipeline session(options);
       session.AddEstimator(std::make_unique<Eskf>(options, [&](const StateEstimate& e) { states.push_back(e); }));
       SimRecord rec;
       while (simulator.Next(&rec)) test::FeedSession(&session, rec);

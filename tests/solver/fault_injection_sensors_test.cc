@@ -214,7 +214,7 @@ TEST(FaultInjection, LogEndsMidInitialisation) {
     const SimOptions sim = FaultDrive(26, 30.0);
     const Options options = test::TestRunOptions(sim);
     Simulator simulator(sim);
-    Session session(options);
+    EstimatorPipeline session(options);
     size_t not_at_rest = 0;
     const StateCallback count = [&](const StateEstimate& s) { not_at_rest += !(s.x.v_w.isZero(0.0)); };
     session.AddEstimator(std::make_unique<Eskf>(options, count));
@@ -238,7 +238,7 @@ TEST(FaultInjection, LogEndsMidInitialisation) {
   auto end = std::make_shared<double>(1e300);
   const DriveRun run = test::RunDriveThroughSession(
       sim, test::TestRunOptions(sim),
-      [end](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, Session& session) {
+      [end](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline& session) {
         if (r.t() >= *end) return;
         feed(r);
         if (*end > 1e299 && session.initialized()) *end = r.t() + 0.5;

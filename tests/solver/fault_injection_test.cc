@@ -1,5 +1,5 @@
 // Fault injection on seeded simulated drives, one test per class of field fault, both estimators through one
-// Session as `gins run` feeds them. Each test writes down the expected behaviour and asserts: no abort, every
+// EstimatorPipeline as `gins run` feeds them. Each test writes down the expected behaviour and asserts: no abort, every
 // output state finite with σ > 0 (fault_harness.h: ExpectSaneOutputs), and the horizontal error back within a
 // stated bound within a stated time after the fault ends. The measured recoveries print as "[fault] ..."
 // lines (the fault table of docs/robustness.md quotes them).
@@ -109,7 +109,7 @@ TEST(FaultInjection, ImuDropoutInsideAGnssOutage) {
 // Drops the IMU records in (t_init, t_init + d), t_init the epoch that completed the initialisation.
 RecordHook ImuDropoutAfterInitialisation(double d) {
   auto t_init = std::make_shared<double>(-1.0);
-  return [t_init, d](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, Session& session) {
+  return [t_init, d](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline& session) {
     if (IsImu(r) && *t_init >= 0.0 && r.t() > *t_init && r.t() < *t_init + d) return;
     feed(r);
     if (*t_init < 0.0 && session.initialized()) *t_init = r.t();
@@ -177,7 +177,7 @@ TEST(FaultInjection, TimeStampJitter) {
   std::uniform_real_distribution<double> jitter(-0.02, 0.02);
   test::ReaderRules reader;
   const DriveRun run = test::RunDriveThroughSession(
-      sim, test::TestRunOptions(sim), [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, Session&) {
+      sim, test::TestRunOptions(sim), [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline&) {
         SimRecord j = r;
         const bool logger_stamped = r.type == SimRecord::Type::kImu || r.type == SimRecord::Type::kWheel;
         if (logger_stamped && r.t() >= t0 && r.t() < t1) test::SetTime(&j, r.t() + jitter(rng));
@@ -222,7 +222,7 @@ TEST(FaultInjection, AllRecordTypesOnOneTimeStamp) {
   const double t0 = sim.start_time + 40.0, t1 = sim.start_time + 50.0;
   test::ReaderRules reader;
   const DriveRun run = test::RunDriveThroughSession(
-      sim, test::TestRunOptions(sim), [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, Session&) {
+      sim, test::TestRunOptions(sim), [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline&) {
         SimRecord b = r;
         if (r.t() > t0 && r.t() <= t1) test::SetTime(&b, t0 + 0.1 * std::ceil((r.t() - t0) / 0.1 - 1e-6));
         if (reader.Accept(b)) feed(b);

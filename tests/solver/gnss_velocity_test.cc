@@ -28,7 +28,7 @@ EstimatorOptions SinglePointOptions(const SimOptions& sim) {
 test::RecordHook WithGvel(double sigma_v, const Vec3& lever_b) {
   auto rng = std::make_shared<std::mt19937>(77);
   auto omega_b = std::make_shared<Vec3>(Vec3::Zero());
-  return [=](const SimRecord& rec, const std::function<void(const SimRecord&)>& feed, Session& session) {
+  return [=](const SimRecord& rec, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline& session) {
     feed(rec);
     if (rec.type == SimRecord::Type::kImu) *omega_b = rec.imu.gyro - rec.truth.bg;
     if (rec.type != SimRecord::Type::kGnss) return;

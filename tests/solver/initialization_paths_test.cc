@@ -1,4 +1,4 @@
-// Each initialisation path end to end (core/initializer.h), on seeded simulated drives through a Session with
+// Each initialisation path end to end (core/initializer.h), on seeded simulated drives through a EstimatorPipeline with
 // both estimators: static with and without wheels, in motion (a log that starts while driving), with and
 // without a dual-antenna heading, reversing, 5 Hz and 20 Hz single-point GNSS, Earth rotation on and off.
 // Every case is started with the defaults' initial-state handling (no initial-state keys exist): only the
@@ -129,7 +129,7 @@ TEST(InitializationPaths, StaticWithWheelsNoHeading) {
 // outlier_t: the fix at that time moved 20 m north (none if 0).
 void ExpectOutputFromTheFirstFix(const SimOptions& sim, const EstimatorOptions& options, const char* name,
                                  double outlier_t = 0.0) {
-  const test::RecordHook hook = [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, Session&) {
+  const test::RecordHook hook = [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline&) {
     if (r.type != SimRecord::Type::kGnss || std::abs(r.gnss.t - outlier_t) > 1e-6) return feed(r);
     SimRecord moved = r;
     moved.gnss.lat_deg += 20.0 / 111111.0;

@@ -15,7 +15,7 @@
 #include "core/sim/simulator.h"
 #include "fault_harness.h"
 #include "solver/eskf.h"
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 #include "solver/smoother.h"
 #include "sim_feed.h"
 #include "test_scenarios.h"
@@ -49,7 +49,7 @@ struct Output {
 Output RunDrive(const SimOptions& sim, const Options& options, const Edit& edit) {
   Output out;
   Simulator simulator(sim);
-  Session session(options);
+  EstimatorPipeline session(options);
   auto eskf = std::make_unique<Eskf>(options, [&](const StateEstimate& e) { out.eskf.push_back(e); });
   auto smoother = std::make_unique<Smoother>(
       options, [&](const StateEstimate& e) { out.smoother.push_back(e); }, nullptr);

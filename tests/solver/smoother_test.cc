@@ -14,7 +14,7 @@
 #include "core/sim/simulator.h"
 #include "core/so3.h"
 #include "solver/eskf.h"
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 #include "sim_feed.h"
 #include "test_scenarios.h"
 
@@ -109,11 +109,11 @@ struct DriveOutput {
   std::vector<double> outlier_times;  // fixes the simulator displaced
 };
 
-// One drive through one Session feeding both estimators (unless with_eskf is false).
+// One drive through one EstimatorPipeline feeding both estimators (unless with_eskf is false).
 DriveOutput RunDrive(const SimOptions& sim, const Options& options, bool with_eskf) {
   DriveOutput out;
   Simulator simulator(sim);
-  Session session(options);
+  EstimatorPipeline session(options);
   if (with_eskf) {
     session.AddEstimator(std::make_unique<Eskf>(options, [&](const StateEstimate& e) { out.eskf.push_back(e); }));
   }

@@ -50,7 +50,7 @@ TEST(VehicleSetups, TenHzFixesAreAllUsed) {
   sim.gnss_outages.clear();
   std::vector<double> fixes;
   const test::RecordHook count_fixes = [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed,
-                                           Session&) {
+                                           EstimatorPipeline&) {
     if (r.type == SimRecord::Type::kGnss) fixes.push_back(r.t());
     feed(r);
   };

@@ -1,7 +1,8 @@
-// A session turns raw log records into estimator input: axis mapping of the IMU, pulses to wheel speed,
-// geodetic fixes to the world frame (its origin fixed at the configured point or the first fix),
-// initialisation (core/initializer.h), then the same time-ordered stream to every estimator. The runner feeds it from a log
-// file; the end-to-end tests feed it from the simulator.
+// The estimator pipeline (the API's Session runs one) turns raw log records into estimator input: axis
+// mapping of the IMU, pulses to wheel speed, geodetic fixes to the world frame (its origin fixed at the
+// configured point or the first fix), initialisation (core/initializer.h), then the same time-ordered stream
+// to every estimator. `gins run` feeds it through the API from a log file; the end-to-end tests feed it from
+// the simulator.
 #pragma once
 
 #include <chrono>
@@ -33,10 +34,10 @@ class RunError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-class Session {
+class EstimatorPipeline {
  public:
-  explicit Session(const EstimatorOptions& options);
-  ~Session();
+  explicit EstimatorPipeline(const EstimatorOptions& options);
+  ~EstimatorPipeline();
 
   void AddEstimator(std::unique_ptr<Estimator> estimator);
   // Runs every estimator after the first on a thread of its own (before the first record; with one
@@ -151,7 +152,7 @@ class Session {
   uint64_t outage_dropped_ = 0, outage_kept_before_init_ = 0;
 };
 
-inline void Session::Add(const LogRecord& r) {
+inline void EstimatorPipeline::Add(const LogRecord& r) {
   switch (r.type) {
     case LogRecord::Type::kImu:
       return AddImu(r.imu);

@@ -1,4 +1,4 @@
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 
 #include <glog/logging.h>
 
@@ -21,15 +21,17 @@ namespace {
 constexpr size_t kMaxPending = 100000;
 }  // namespace
 
-Session::Session(const EstimatorOptions& options) : options_(options) {
+EstimatorPipeline::EstimatorPipeline(const EstimatorOptions& options) : options_(options) {
   if (options_.gnss.origin) frame_.emplace(*options_.gnss.origin);
 }
 
-void Session::AddEstimator(std::unique_ptr<Estimator> estimator) { estimators_.push_back({std::move(estimator), {}}); }
+void EstimatorPipeline::AddEstimator(std::unique_ptr<Estimator> estimator) {
+  estimators_.push_back({std::move(estimator), {}});
+}
 
 // One estimator's thread: batches of tasks in order, a bounded queue (the reader waits rather than buffer
 // the log), the first exception kept for the caller.
-struct Session::Worker {
+struct EstimatorPipeline::Worker {
   static constexpr size_t kBatch = 256;     // tasks handed over at once
   static constexpr size_t kMaxQueued = 64;  // batches waiting before the caller waits
 
@@ -93,19 +95,19 @@ struct Session::Worker {
   std::thread thread;        // last: starts once the members above exist
 };
 
-Session::~Session() { CancelThreads(); }
+EstimatorPipeline::~EstimatorPipeline() { CancelThreads(); }
 
-void Session::CancelThreads() {
+void EstimatorPipeline::CancelThreads() {
   for (auto& w : workers_) w->Stop(true);
   workers_.clear();
 }
 
 template <typename M>
-void Session::Dispatch(void (Estimator::*add)(const M&), const M& m) {
+void EstimatorPipeline::Dispatch(void (Estimator::*add)(const M&), const M& m) {
   DispatchTask([add, m](Estimator& e) { (e.*add)(m); });
 }
 
-void Session::DispatchTask(const std::function<void(Estimator&)>& task) {
+void EstimatorPipeline::DispatchTask(const std::function<void(Estimator&)>& task) {
   if (parallel_ && workers_.empty() && estimators_.size() > 1) {
     // estimators_ no longer grows (the first record came): its elements keep their addresses.
     for (size_t i = 1; i < estimators_.size(); ++i) workers_.push_back(std::make_unique<Worker>(&estimators_[i]));
@@ -124,7 +126,7 @@ void Session::DispatchTask(const std::function<void(Estimator&)>& task) {
   }
 }
 
-void Session::StopWorkers() {
+void EstimatorPipeline::StopWorkers() {
   std::exception_ptr error;
   for (auto& w : workers_) {
     w->Stop();
@@ -134,12 +136,12 @@ void Session::StopWorkers() {
   if (error) std::rethrow_exception(error);
 }
 
-void Session::Touch(double t) {
+void EstimatorPipeline::Touch(double t) {
   if (first_t_ < 0.0) first_t_ = t;
   last_t_ = std::max(last_t_, t);
 }
 
-void Session::EnsureInitializer() {
+void EstimatorPipeline::EnsureInitializer() {
   if (init_ || !frame_) return;
   earth_ = EarthModel::FromOptions(*frame_, options_.gravity);
   g_norm_ = earth_.g_norm();
@@ -158,7 +160,7 @@ void Session::EnsureInitializer() {
   pending_wheel_ = {};
 }
 
-void Session::WatchImuInterval(double t) {
+void EstimatorPipeline::WatchImuInterval(double t) {
   constexpr int kRunForRateChange = 10;
   const std::optional<double> last = last_imu_t_;
   last_imu_t_ = t;
@@ -189,7 +191,7 @@ void Session::WatchImuInterval(double t) {
   }
 }
 
-void Session::AddImu(const ImuSample& raw) {
+void EstimatorPipeline::AddImu(const ImuSample& raw) {
   Touch(raw.t);
   WatchImuInterval(raw.t);
   ImuSample s = raw;
@@ -242,7 +244,7 @@ StateEstimate RestEstimate(const RestState& r) {
 }
 }  // namespace
 
-void Session::SendRestStates() {
+void EstimatorPipeline::SendRestStates() {
   rest_scratch_.clear();
   init_->RestStates(last_rest_t_, &rest_scratch_);
   for (const RestState& r : rest_scratch_) {
@@ -255,7 +257,7 @@ void Session::SendRestStates() {
   }
 }
 
-void Session::FlushRestState(double init_t) {
+void EstimatorPipeline::FlushRestState(double init_t) {
   if (rest_held_ && rest_held_->x.t < init_t) {
     Dispatch(&Estimator::AddRestState, RestEstimate(*rest_held_));
     ++rest_sent_;
@@ -263,7 +265,7 @@ void Session::FlushRestState(double init_t) {
   rest_held_.reset();
 }
 
-void Session::DetectStandstill(double t) {
+void EstimatorPipeline::DetectStandstill(double t) {
   constexpr double kInterval = 0.1;  // s between standstill updates
   if (!standstill_->Standing()) {
     standing_since_ = -1.0;
@@ -283,7 +285,7 @@ void Session::DetectStandstill(double t) {
   Dispatch(&Estimator::AddStandstill, m);
 }
 
-void Session::AddWheel(const WheelRecord& o) {
+void EstimatorPipeline::AddWheel(const WheelRecord& o) {
   Touch(o.t);
   if (!options_.wheel.enabled) {
     ++odom_ignored_;
@@ -305,7 +307,7 @@ void Session::AddWheel(const WheelRecord& o) {
   }
 }
 
-WheelMeasurement Session::WheelFromOdom(const WheelRecord& o) {
+WheelMeasurement EstimatorPipeline::WheelFromOdom(const WheelRecord& o) {
   const WheelOptions& wo = options_.wheel;
   // The pulses were counted since the previous record: its spacing is the interval, within half the
   // nominal one either way (clock jitter, counted); a longer spacing means records were lost, and the
@@ -339,7 +341,7 @@ WheelMeasurement Session::WheelFromOdom(const WheelRecord& o) {
   return w;
 }
 
-void Session::AddGnss(const GnssRecord& g) {
+void EstimatorPipeline::AddGnss(const GnssRecord& g) {
   Touch(g.t);
   if (DropForSimulatedOutage(g.t)) return;
   if (!frame_) frame_.emplace(GeodeticPoint{g.lat_deg, g.lon_deg, g.alt_m});
@@ -385,7 +387,7 @@ void Session::AddGnss(const GnssRecord& g) {
   }
 }
 
-void Session::AddGnssVelocity(const GnssVelocityRecord& g) {
+void EstimatorPipeline::AddGnssVelocity(const GnssVelocityRecord& g) {
   Touch(g.t);
   const bool in_outage = initialized_ && !outage_schedule_.empty() && outage_schedule_.Contains(g.t, first_t_);
   if (!options_.gnss.use_velocity || !last_fix_geo_ || !init_ || in_outage) {
@@ -405,7 +407,7 @@ void Session::AddGnssVelocity(const GnssVelocityRecord& g) {
 }
 
 // --- Simulated GNSS outages ---------------------------------------------------------------------------------
-bool Session::DropForSimulatedOutage(double t) {
+bool EstimatorPipeline::DropForSimulatedOutage(double t) {
   gnss_gaps_.Add(t);
   if (outage_schedule_.empty() || !outage_schedule_.Contains(t, first_t_)) return false;
   if (!initialized_) {
@@ -416,19 +418,19 @@ bool Session::DropForSimulatedOutage(double t) {
   return true;
 }
 
-std::string Session::Diagnosis() const {
+std::string EstimatorPipeline::Diagnosis() const {
   if (initialized_) return "initialised";
   if (!init_) return "no GNSS fix, so no world frame";
   return init_->Diagnosis();
 }
 
-void Session::Finish() {
+void EstimatorPipeline::Finish() {
   if (!initialized_) throw RunError(Diagnosis());
   DispatchTask([](Estimator& e) { e.Finish(); });
   StopWorkers();
 }
 
-nlohmann::json Session::Stats() const {
+nlohmann::json EstimatorPipeline::Stats() const {
   nlohmann::json j;
   namespace k = summary_keys;
   j[k::kOdomIgnoredWheelDisabled] = odom_ignored_;

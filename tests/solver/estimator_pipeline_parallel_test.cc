@@ -1,4 +1,4 @@
-// Session::SetParallel: every estimator after the first on a thread of its own gives the same streams,
+// EstimatorPipeline::SetParallel: every estimator after the first on a thread of its own gives the same streams,
 // bit for bit, as the sequential run, and the same statistics.
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include "core/sim/simulator.h"
 #include "sim_feed.h"
 #include "solver/eskf.h"
-#include "solver/session.h"
+#include "solver/estimator_pipeline.h"
 #include "solver/smoother.h"
 #include "test_scenarios.h"
 
@@ -26,7 +26,7 @@ Streams RunDrive(bool parallel) {
   sim.segments.resize(8);  // 95 s
   const Options options = test::TestRunOptions(sim);
   Streams out;
-  Session session(options);
+  EstimatorPipeline session(options);
   session.SetParallel(parallel);
   session.AddEstimator(std::make_unique<Eskf>(
       options, [&](const StateEstimate& e) { out.eskf.push_back(e); },

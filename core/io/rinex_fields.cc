@@ -51,12 +51,6 @@ bool ParseCalendarFields(std::string_view year, std::string_view month, std::str
 
 }  // namespace rinex_internal
 
-std::string SatelliteId::ToString() const {
-  char buf[8];
-  std::snprintf(buf, sizeof(buf), "%c%02d", static_cast<char>(system), prn % 100);
-  return buf;
-}
-
 bool ParseGnssSystem(char letter, GnssSystem* system) {
   switch (letter) {
     case 'G': case 'R': case 'E': case 'C': case 'J': case 'S': case 'I':

@@ -12,11 +12,6 @@ using rinex_internal::ParseCalendarFields;
 using rinex_internal::ParseInt;
 using rinex_internal::Trim;
 
-double KeplerEphemeris::toe_gps_s() const {
-  if (sat.system == GnssSystem::kBeidou) return (week + kBdtWeekOffset) * kSecondsPerWeek + toe_s + kGpsMinusBdt;
-  return week * kSecondsPerWeek + toe_s;
-}
-
 namespace {
 
 using input_reason::kAbsurdValue;

@@ -8,6 +8,7 @@
 //   KeyLister  (key_lister.h)   list the key paths: ConfigKeys.
 // A visitor has one method per kind of value, each taking the key first:
 //   Number(key, double&, Unit, Check[, Presence])   Integer(key, int-type&, min[, max])   Boolean(key, bool&)
+//   String(key, std::string&)
 //   Choice(key, T&, Choices<T>)   Vector3(key, Vec3&, what, Check)   Axes(key, Mat3&)
 //   Origin(key, GeodeticPoint& or optional<GeodeticPoint>&)   Outages(key, [[start, duration]]&)
 //   PeriodicOutages(key, GnssOptions::PeriodicOutages&)
@@ -157,6 +158,40 @@ inline constexpr auto kSegmentKeys = [](auto& v, SimSegment& s) {
   v.Boolean("reverse", s.reverse);
 };
 
+// An item of simulate.raw_gnss_blocked.
+inline constexpr auto kRawGnssBlockedKeys = [](auto& v, RawGnssBlockedWindow& w) {
+  v.Number("start_s", w.start_s, kNoUnit, NonNegative(), Presence::kRequired);
+  v.Number("duration_s", w.duration_s, kNoUnit, Positive(), Presence::kRequired);
+  v.Integer("max_visible", w.max_visible, 0, 999);
+};
+
+// The raw observations of gins simulate (core/sim/raw_gnss.h): keys of the simulate section with a prefix,
+// since a section holds keys, not sections.
+inline constexpr auto kRawGnssKeys = [](auto& v, RawGnssSimConfig& o) {
+  v.Boolean("raw_gnss_enabled", o.enabled);
+  v.String("raw_gnss_nav_file", o.nav_file);
+  v.Number("raw_gnss_rate_hz", o.rate_hz, kNoUnit, Positive());
+  v.String("raw_gnss_gps_signals", o.gps_signals);
+  v.String("raw_gnss_galileo_signals", o.galileo_signals);
+  v.String("raw_gnss_beidou_signals", o.beidou_signals);
+  RawGnssSimOptions& s = o.options;
+  v.Number("raw_gnss_elevation_mask_deg", s.elevation_mask_deg, kNoUnit, Within(0.0, 89.0));
+  v.Number("raw_gnss_clock_bias_s", s.clock_bias_s, kNoUnit, Within(-0.5, 0.5));
+  v.Number("raw_gnss_clock_drift_s_s", s.clock_drift_s_s, kNoUnit, Within(-1e-4, 1e-4));
+  v.Number("raw_gnss_clock_drift_rw_s_s_sqrt_s", s.clock_drift_rw_s_s_sqrt_s, kNoUnit, NonNegative());
+  v.Number("raw_gnss_code_sigma_a_m", s.code_sigma_a_m, kNoUnit, NonNegative());
+  v.Number("raw_gnss_code_sigma_b_m", s.code_sigma_b_m, kNoUnit, NonNegative());
+  v.Number("raw_gnss_multipath_sigma_m", s.multipath_sigma_m, kNoUnit, NonNegative());
+  v.Number("raw_gnss_multipath_tau_s", s.multipath_tau_s, kNoUnit, Positive());
+  v.Number("raw_gnss_doppler_sigma_m_s", s.doppler_sigma_m_s, kNoUnit, NonNegative());
+  v.Number("raw_gnss_phase_sigma_m", s.phase_sigma_m, kNoUnit, NonNegative());
+  v.Boolean("raw_gnss_ionosphere", s.ionosphere);
+  v.Boolean("raw_gnss_troposphere", s.troposphere);
+  v.Number("raw_gnss_iono_residual_fraction", s.iono_residual_fraction, kNoUnit, NonNegative());
+  v.Number("raw_gnss_tropo_residual_fraction", s.tropo_residual_fraction, kNoUnit, NonNegative());
+  v.List("raw_gnss_blocked", "window", s.blocked, kRawGnssBlockedKeys);
+};
+
 inline constexpr auto kSimulateKeys = [](auto& v, SimOptions& o) {
   v.Integer("seed", o.seed, 0, std::numeric_limits<unsigned>::max());
   v.Number("start_time_s", o.start_time, kNoUnit, NonNegative());
@@ -193,6 +228,7 @@ inline constexpr auto kSimulateKeys = [](auto& v, SimOptions& o) {
   v.Vector3("gnss_velocity_sigma_m_s", o.gnss_velocity_sigma, "[east, north, up]", NonNegative());
   v.Number("gnss_noise_correlation_s", o.gnss_noise_correlation, kNoUnit, NonNegative());
   v.Number("log_start_s", o.log_start, kNoUnit, NonNegative());
+  kRawGnssKeys(v, o.raw_gnss);
 };
 
 // The sections of a config file, in file order.

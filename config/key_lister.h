@@ -33,6 +33,10 @@ class KeyLister {
     Add(key);
   }
   template <class... Rest>
+  void String(const char* key, Rest&&...) {
+    Add(key);
+  }
+  template <class... Rest>
   void Choice(const char* key, Rest&&...) {
     Add(key);
   }

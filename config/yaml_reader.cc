@@ -233,6 +233,17 @@ void YamlReader::Boolean(const char* key, bool& out) {
   }
 }
 
+void YamlReader::String(const char* key, std::string& out) {
+  const YAML::Node* n = Find(key);
+  if (n == nullptr) return;
+  if (n->IsNull()) {
+    out.clear();
+    return;
+  }
+  if (!n->IsScalar()) Fail(key, "expected a text, got " + Describe(*n), *n);
+  out = n->Scalar();
+}
+
 int YamlReader::ChoiceIndex(const char* key, const std::vector<std::string>& names) {
   const YAML::Node* n = Find(key);
   if (n == nullptr) return -1;

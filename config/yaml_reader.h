@@ -59,6 +59,7 @@ class YamlReader {
                     const Check& check);
 
   void Boolean(const char* key, bool& out);
+  void String(const char* key, std::string& out);  // a scalar taken as it is; null: empty
 
   template <class T>
   void Choice(const char* key, T& out, const Choices<T>& choices) {

@@ -64,6 +64,15 @@ std::string FormatNumber(double si, const Unit& unit) {
   return best.empty() ? Text(guess, 17) : best;
 }
 
+void YamlWriter::String(const char* key, const std::string& value) {
+  std::string quoted = "\"";
+  for (const char c : value) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
+  }
+  Put(key, quoted + "\"");
+}
+
 void YamlWriter::Put(const char* key, const std::string& value) {
   if (style_ == Style::kFlow) {
     os_ << (first_ ? "" : ", ") << key << ": " << value;

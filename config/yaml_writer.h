@@ -40,6 +40,7 @@ class YamlWriter {
     Put(key, is_word ? std::string(word) : FormatNumber(value, unit));
   }
   void Boolean(const char* key, bool value) { Put(key, value ? "true" : "false"); }
+  void String(const char* key, const std::string& value);  // double-quoted, so any text reads back as it is
 
   template <class T>
   void Choice(const char* key, const T& value, const Choices<T>& choices) {

@@ -302,6 +302,23 @@ RinexObsEpoch RawGnssSimulator::Simulate(const RawGnssTruth& truth) {
   return epoch;
 }
 
+std::map<GnssSystem, std::vector<std::string>> RawGnssSignalsFromText(const RawGnssSimConfig& config) {
+  std::map<GnssSystem, std::vector<std::string>> signals;
+  for (const auto& [system, text] : {std::pair<GnssSystem, const std::string*>{GnssSystem::kGps, &config.gps_signals},
+                                     {GnssSystem::kGalileo, &config.galileo_signals},
+                                     {GnssSystem::kBeidou, &config.beidou_signals}}) {
+    size_t at = 0;
+    while (at < text->size()) {
+      const size_t begin = text->find_first_not_of(' ', at);
+      if (begin == std::string::npos) break;
+      const size_t end = std::min(text->find(' ', begin), text->size());
+      signals[system].push_back(text->substr(begin, end - begin));
+      at = end;
+    }
+  }
+  return signals;
+}
+
 size_t WriteSimulatedRinexObs(const std::string& path, RawGnssSimulator* simulator, const RawGnssFileOptions& file,
                               const std::function<RawGnssTruth(double gps_s)>& truth_at) {
   Require(file.rate_hz > 0.0 && std::isfinite(file.rate_hz), "rate must be > 0");

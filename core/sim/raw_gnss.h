@@ -159,4 +159,18 @@ struct RawGnssFileOptions {
 size_t WriteSimulatedRinexObs(const std::string& path, RawGnssSimulator* simulator, const RawGnssFileOptions& file,
                               const std::function<RawGnssTruth(double gps_s)>& truth_at);
 
+// `gins simulate`'s raw observations (simulate.raw_gnss_* keys): obs.rnx next to log.txt, the antenna of the
+// truth trajectory (lever_arm_m) at the log's times taken as GPS seconds (start_time_s is a GPS time).
+struct RawGnssSimConfig {
+  bool enabled = false;
+  std::string nav_file;  // RINEX 3 navigation file (its GPSA/GPSB, if any, are the true Klobuchar α/β)
+  double rate_hz = 1.0;
+  // Bands per system separated by blanks ("1C 2L"); empty: the system is not simulated. Replace
+  // options.signals when the file is made (RawGnssSignalsFromText).
+  std::string gps_signals = "1C 2L", galileo_signals = "1C 7Q", beidou_signals = "2I 6I";
+  RawGnssSimOptions options;
+};
+// options.signals from the three texts (bands as given, unchecked: the simulator refuses unknown ones).
+std::map<GnssSystem, std::vector<std::string>> RawGnssSignalsFromText(const RawGnssSimConfig& config);
+
 }  // namespace gins

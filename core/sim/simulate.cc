@@ -5,7 +5,11 @@
 #include <stdexcept>
 #include <system_error>
 
+#include <GeographicLib/Geocentric.hpp>
+
+#include "core/io/rinex.h"
 #include "core/io/trajectory_writer.h"
+#include "core/sim/raw_gnss.h"
 #include "core/sim/simulator.h"
 
 namespace gins {
@@ -93,6 +97,66 @@ void WriteRecord(const Simulator& simulator, const SimRecord& r, AtomicFile* log
   }
 }
 
+// obs.rnx: the raw observations of the antenna over the logged span (core/sim/raw_gnss.h). w is the local ENU
+// frame at the origin fixed to the Earth (LocalEnuFrame, GeographicLib's LocalCartesian), so
+// r_ecef = r0_ecef + R_ecef_w·p_w exactly, and velocities in w turn by R_ecef_w alone.
+uint64_t WriteRawGnss(const SimOptions& sim, const TruthTrajectory& truth, const std::string& path) {
+  const RawGnssSimConfig& config = sim.raw_gnss;
+  if (config.nav_file.empty()) {
+    throw std::invalid_argument("simulate.raw_gnss_nav_file: required when raw_gnss_enabled is true");
+  }
+  const RinexNav nav = ReadRinexNav(config.nav_file, InputOptions{});
+  RawGnssSimOptions options = config.options;
+  options.signals = RawGnssSignalsFromText(config);
+  for (const RinexIonoCorrection& c : nav.header.iono) {  // the file's broadcast ionosphere is the truth's
+    if (c.type == "GPSA") options.klobuchar_alpha = c.params;
+    if (c.type == "GPSB") options.klobuchar_beta = c.params;
+  }
+  // Its own seed, drawn from the master past the sensors' streams (simulator.cc uses indices 0..7).
+  std::mt19937_64 master(sim.seed);
+  master.discard(16);
+  RawGnssSimulator raw(nav.kepler, options, master());
+  const GeodeticPoint& o = sim.origin;
+  Vec3 r0_ecef;
+  std::vector<double> m(9);
+  GeographicLib::Geocentric::WGS84().Forward(o.lat_deg, o.lon_deg, o.alt_m, r0_ecef.x(), r0_ecef.y(), r0_ecef.z(),
+                                             m);
+  Mat3 R_ecef_w;
+  R_ecef_w << m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8];  // row-major, ENU to ECEF
+  auto antenna = [&](double gps_s) {
+    const TruthState x = truth.At(std::min(gps_s, truth.end_time()));
+    const Mat3 R_wb = x.q_wb.toRotationMatrix();
+    const Vec3 p_w = x.p_wb + R_wb * sim.lever_b;
+    const Vec3 v_w = x.v_w + R_wb * x.omega_b.cross(sim.lever_b);
+    return RawGnssTruth{gps_s, r0_ecef + R_ecef_w * p_w, R_ecef_w * v_w};
+  };
+  RawGnssFileOptions file;
+  file.start_gps_s = truth.start_time() + sim.log_start;
+  file.end_gps_s = truth.end_time();
+  file.rate_hz = config.rate_hz;
+  return WriteSimulatedRinexObs(path, &raw, file, antenna);
+}
+
+void WriteLogAndTruth(const SimOptions& sim, Simulator& simulator, const std::string& log_path,
+                      const std::string& truth_path, SimulationResult* result) {
+  AtomicFile log(log_path);
+  AtomicFile truth(truth_path);
+
+  WriteLogHeader(sim, simulator, &log);
+  truth.Write("t,lat,lon,alt,qw,qx,qy,qz,ve,vn,vu\n");
+  result->duration = simulator.truth().duration();
+  SimRecord r;
+  while (simulator.Next(&r)) WriteRecord(simulator, r, &log, &truth, result);
+  // Both files or neither: a truth without its log (or the reverse) would mislead.
+  truth.Commit();
+  try {
+    log.Commit();
+  } catch (...) {
+    std::remove(truth_path.c_str());
+    throw;
+  }
+}
+
 }  // namespace
 
 SimulationResult Simulate(const SimOptions& sim, const std::string& out_dir) {
@@ -104,21 +168,13 @@ SimulationResult Simulate(const SimOptions& sim, const std::string& out_dir) {
   }
   const std::string log_path = (std::filesystem::path(out_dir) / "log.txt").string();
   const std::string truth_path = (std::filesystem::path(out_dir) / "truth.csv").string();
-  AtomicFile log(log_path);
-  AtomicFile truth(truth_path);
-
-  WriteLogHeader(sim, simulator, &log);
-  truth.Write("t,lat,lon,alt,qw,qx,qy,qz,ve,vn,vu\n");
+  const std::string obs_path = (std::filesystem::path(out_dir) / "obs.rnx").string();
   SimulationResult result;
-  result.duration = simulator.truth().duration();
-  SimRecord r;
-  while (simulator.Next(&r)) WriteRecord(simulator, r, &log, &truth, &result);
-  // Both files or neither: a truth without its log (or the reverse) would mislead.
-  truth.Commit();
+  if (sim.raw_gnss.enabled) result.raw_gnss_epochs = WriteRawGnss(sim, simulator.truth(), obs_path);
   try {
-    log.Commit();
+    WriteLogAndTruth(sim, simulator, log_path, truth_path, &result);
   } catch (...) {
-    std::remove(truth_path.c_str());
+    if (sim.raw_gnss.enabled) std::remove(obs_path.c_str());  // all the files or none
     throw;
   }
   return result;

@@ -72,6 +72,7 @@
 #include "core/io/log_record.h"
 #include "core/measurements.h"
 #include "core/nav_state.h"
+#include "core/sim/raw_gnss.h"
 
 namespace gins {
 
@@ -115,6 +116,7 @@ struct SimOptions {
   Vec3 gnss_velocity_sigma = Vec3::Zero();  // m/s per ENU axis; all zero: no GVEL records
   double gnss_noise_correlation = 0.0;      // s, τ of the GNSS position noise; 0: white
   double log_start = 0.0;                   // s after start_time before which nothing is logged
+  RawGnssSimConfig raw_gnss;                // obs.rnx (core/sim/raw_gnss.h), off by default
 };
 
 // The true motion at one instant.
@@ -277,12 +279,14 @@ class Simulator {
 
 struct SimulationResult {
   uint64_t imu = 0, gnss = 0, wheel = 0, gnss_velocity = 0;
+  uint64_t raw_gnss_epochs = 0;  // of obs.rnx, when simulate.raw_gnss_enabled
   double duration = 0.0;  // s, of the whole drive (from start_time, whatever log_start)
 };
 
 // Runs the drive and writes out_dir/log.txt (docs/formats.md §3, with a `# gins simulate seed=...` header) and
 // out_dir/truth.csv (docs/formats.md §4, one row per IMU record; attitude and velocity in the local ENU frame at the
-// row's point when rotating, in w when flat). out_dir is created if missing. Each file is written under a
+// row's point when rotating, in w when flat), and with raw_gnss.enabled out_dir/obs.rnx (core/sim/raw_gnss.h:
+// RawGnssSimConfig). out_dir is created if missing. Each file is written under a
 // temporary name and renamed into place when complete. Throws std::invalid_argument on invalid options and
 // std::runtime_error on I/O failure.
 SimulationResult Simulate(const SimOptions& sim, const std::string& out_dir);

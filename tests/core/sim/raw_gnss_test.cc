@@ -8,10 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "config/config_loader.h"
 #include "core/chi2.h"
 #include "core/gnss_spp.h"
 #include "core/io/rinex.h"
 #include "core/sim/raw_gnss.h"
+#include "core/sim/simulator.h"
 #include "test_util.h"
 
 namespace gins {
@@ -294,6 +296,51 @@ TEST(RawGnss, WritesAFileTheReaderGivesBack) {
     }
   }
   EXPECT_EQ(n, 20);
+}
+
+// gins simulate with simulate.raw_gnss_*: obs.rnx of the antenna (lever arm, ECEF from w, GPS times) that
+// SolveSpp turns back into the antenna's truth while the vehicle drives.
+TEST(RawGnss, SimulateWritesTheAntennasObservations) {
+  const Options options = LoadOptionsFromString(
+      "simulate:\n  start_time_s: 1440437500\n  origin: [40.0967, -105.1472, 1580.0]\n"
+      "  segments: [{duration_s: 5}, {duration_s: 10, accel_m_s2: 1.0, yaw_rate_deg_s: 5}]\n"
+      "  raw_gnss_enabled: true\n  raw_gnss_nav_file: \"" GINS_TEST_DATA_DIR "/rinex/walk.nav\"\n"
+      "  raw_gnss_clock_drift_rw_s_s_sqrt_s: 0\n  raw_gnss_code_sigma_a_m: 0\n  raw_gnss_code_sigma_b_m: 0\n"
+      "  raw_gnss_multipath_sigma_m: 0\n  raw_gnss_iono_residual_fraction: 0\n"
+      "  raw_gnss_tropo_residual_fraction: 0\n  raw_gnss_galileo_signals: \"\"\n"
+      "  raw_gnss_blocked: [{start_s: 3, duration_s: 2, max_visible: 0}]\n",
+      "raw.yaml");
+  const SimOptions& sim = options.simulate;
+  ASSERT_TRUE(sim.raw_gnss.enabled);
+  ASSERT_EQ(sim.raw_gnss.options.blocked.size(), 1u);
+  EXPECT_EQ(sim.raw_gnss.options.blocked[0].max_visible, 0);
+  EXPECT_EQ(RawGnssSignalsFromText(sim.raw_gnss).count(GnssSystem::kGalileo), 0u);
+  const std::string dir = test::MakeTempDir("raw_gnss_simulate");
+  EXPECT_EQ(Simulate(sim, dir).raw_gnss_epochs, 14u);  // 0..15 s but the outage's 3 and 4
+  const TruthTrajectory truth(sim);
+  const Vec3 r0_ecef = GeodeticToEcef(40.0967, -105.1472, 1580.0);
+  RinexObsReader reader(dir + "/obs.rnx", InputOptions{});
+  RawGnssSimOptions raw = sim.raw_gnss.options;
+  raw.signals = RawGnssSignalsFromText(sim.raw_gnss);
+  RinexObsEpoch e;
+  int epochs = 0;
+  while (reader.Next(&e)) {
+    for (const RinexSatelliteObs& s : e.satellites) ASSERT_NE(s.sat.system, GnssSystem::kGalileo);
+    const double t = kT0 + std::round(e.gps_s - kT0);  // the true time: the clock is 0.1 ms ahead
+    const SppSolution sol = SolveSpp(e.gps_s, CodeObservations(e, raw, 0), Ephemerides(), SppLike(raw));
+    ASSERT_TRUE(sol.ok) << sol.why;
+    const TruthState x = truth.At(t);
+    // The antenna in ECEF: the w frame is the ENU frame at the origin.
+    const double lat = 40.0967 * kDegToRad, lon = -105.1472 * kDegToRad;
+    Mat3 R_ecef_w;
+    R_ecef_w.col(0) = Vec3(-std::sin(lon), std::cos(lon), 0.0);
+    R_ecef_w.col(1) = Vec3(-std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat));
+    R_ecef_w.col(2) = Vec3(std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat));
+    const Vec3 antenna_ecef = r0_ecef + R_ecef_w * (x.p_wb + x.q_wb.toRotationMatrix() * sim.lever_b);
+    EXPECT_LT((sol.position_ecef_m - antenna_ecef).norm(), 0.02) << t - kT0;
+    ++epochs;
+  }
+  EXPECT_EQ(epochs, 14);
 }
 
 }  // namespace

@@ -188,7 +188,9 @@ bool RawGnssSimulator::Geometry(const KeplerEphemeris& eph, const RawGnssTruth& 
                                       : KlobucharL1Delay(options_.Alpha(), options_.Beta(), g.lat, g.lon, s->azel.az,
                                                          s->azel.el, std::fmod(truth.gps_s, kSecondsPerWeek)) *
                                             (1.0 + iono_residual_.at(eph.sat));
-  s->tropo_m = !options_.troposphere ? 0.0 : SaastamoinenSlant(g.lat, g.h, s->azel.el) * (1.0 + tropo_residual_.at(eph.sat));
+  s->tropo_m = !options_.troposphere
+                   ? 0.0
+                   : SaastamoinenSlant(g.lat, g.h, s->azel.el) * (1.0 + tropo_residual_.at(eph.sat));
   return true;
 }
 
@@ -209,7 +211,9 @@ void RawGnssSimulator::KeepVisible(double gps_s, std::vector<Seen>* seen) const 
   const double elapsed = gps_s - first_gps_s_;
   size_t keep = seen->size();
   for (const RawGnssBlockedWindow& w : options_.blocked) {
-    if (elapsed >= w.start_s && elapsed < w.start_s + w.duration_s) keep = std::min(keep, static_cast<size_t>(w.max_visible));
+    if (elapsed >= w.start_s && elapsed < w.start_s + w.duration_s) {
+      keep = std::min(keep, static_cast<size_t>(w.max_visible));
+    }
   }
   if (keep == seen->size()) return;
   // The highest satellites stay (ties by id, for a repeatable choice), then id order again.

@@ -7,8 +7,8 @@
 //                   integrated by the trapezoid rule); the epoch's tag is t_rx = t + dt_r (a free-running
 //                   receiver clock dates its epochs on its own time).
 //   light time      τ = |r_sat − r_rx|/c iterated, r_sat = Rz(Ω_e·τ)·r_sat_ecef(t − τ): the satellite at
-//                   the transmit time in the ECEF frame of reception (IS-GPS-200 §20.3.3.4.3.4;
-//                   EarthRotationCorrection with the system's OrbitConstants), ρ = |r_sat − r_rx|.
+//                   the transmit time in the ECEF frame of reception (the Earth-rotation correction of
+//                   SatelliteAtTransmit: EarthRotationCorrection with the system's Ω_e), ρ = |r_sat − r_rx|.
 //   pseudorange     P = ρ + c·dt_r − c·(Δt_sv(t − τ) − GroupDelay(signal)) + I_s + T + ε + m
 //                   (IS-GPS-200 §20.3.3.3.3: the SV clock, relativity included, minus the signal's group delay).
 //   ionosphere      I_s = (f_L1/f)²·Klobuchar(α, β)·(1 + k_iono), k_iono ~ N(0, iono_residual_fraction) per

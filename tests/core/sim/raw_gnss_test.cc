@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -236,6 +237,20 @@ TEST(RawGnss, BlockedWindowsKeepTheHighest) {
     }
     previous = some;
   }
+}
+
+TEST(RawGnss, RefusesWhatItHasNoModelFor) {
+  RawGnssSimOptions sim;
+  sim.signals = {{GnssSystem::kGps, {"1C", "9Z"}}};
+  EXPECT_THROW(RawGnssSimulator(Ephemerides(), sim, 1), std::invalid_argument);
+  sim.signals = {{GnssSystem::kGlonass, {"1C"}}};
+  EXPECT_THROW(RawGnssSimulator(Ephemerides(), sim, 1), std::invalid_argument);
+  sim = RawGnssSimOptions{};
+  sim.multipath_tau_s = 0.0;
+  EXPECT_THROW(RawGnssSimulator(Ephemerides(), sim, 1), std::invalid_argument);
+  RawGnssSimulator ok(Ephemerides(), RawGnssSimOptions{}, 1);
+  ok.Simulate(Static(kT0));
+  EXPECT_THROW(ok.Simulate(Static(kT0)), std::invalid_argument);  // time must advance
 }
 
 std::vector<RinexObsEpoch> SimulateRun(uint64_t seed, int epochs) {

@@ -24,13 +24,6 @@ bool AllZero(const std::array<double, 4>& a) {
   return a[0] == 0.0 && a[1] == 0.0 && a[2] == 0.0 && a[3] == 0.0;
 }
 
-// Seed of random source `index`: the index-th draw of the master engine (as core/sim/simulator.cc).
-uint64_t DerivedSeed(uint64_t seed, int index) {
-  std::mt19937_64 master(seed);
-  master.discard(static_cast<unsigned long long>(index));
-  return master();
-}
-
 void Require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument("raw GNSS simulator: " + message);
 }
@@ -86,15 +79,6 @@ std::map<GnssSystem, std::vector<std::string>> RawGnssObsTypes(const RawGnssSimO
     }
   }
   return types;
-}
-
-double RawGnssSimulator::Rng::Uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
-
-double RawGnssSimulator::Rng::Normal() {
-  // Box–Muller with both uniforms drawn every time: each normal costs exactly two engine draws.
-  const double u1 = 1.0 - Uniform();  // (0, 1]
-  const double u2 = Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
 }
 
 // One satellite's geometry, clock and atmosphere at an epoch.

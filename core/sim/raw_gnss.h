@@ -44,6 +44,7 @@
 #include "core/conventions.h"
 #include "core/gnss_orbit.h"
 #include "core/io/rinex.h"
+#include "core/sim/sim_random.h"
 
 namespace gins {
 
@@ -111,15 +112,7 @@ class RawGnssSimulator {
   const RawGnssSimOptions& options() const { return options_; }
 
  private:
-  class Rng {
-   public:
-    explicit Rng(uint64_t seed) : engine_(seed) {}
-    double Uniform();  // [0, 1)
-    double Normal();
-
-   private:
-    std::mt19937_64 engine_;
-  };
+  using Rng = SimRng;  // core/sim/sim_random.h
   struct Signal {
     std::string band;  // "1C"
     GnssSignal signal;

@@ -47,24 +47,6 @@ uint64_t LastIndex(double rate, double duration) {
 
 }  // namespace
 
-double Simulator::Rng::Uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
-
-double Simulator::Rng::Normal() {
-  // Box–Muller with both uniforms drawn every time, so each normal costs exactly two engine draws.
-  const double u1 = 1.0 - Uniform();  // (0, 1]
-  const double u2 = Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
-}
-
-namespace {
-// Seed of random source `index`: the index-th draw of the master engine.
-uint64_t DerivedSeed(unsigned seed, int index) {
-  std::mt19937_64 master(seed);
-  master.discard(static_cast<unsigned long long>(index));
-  return master();
-}
-}  // namespace
-
 Simulator::Simulator(const SimOptions& sim)
     : sim_(sim),
       truth_(sim),

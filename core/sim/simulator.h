@@ -73,6 +73,7 @@
 #include "core/measurements.h"
 #include "core/nav_state.h"
 #include "core/sim/raw_gnss.h"
+#include "core/sim/sim_random.h"
 
 namespace gins {
 
@@ -235,17 +236,7 @@ class Simulator {
   Mat3 LocalToWorld(const Vec3& p_w) const;
 
  private:
-  // Uniform and standard normal draws from one engine, independent of the library's distributions.
-  class Rng {
-   public:
-    explicit Rng(uint64_t seed) : engine_(seed) {}
-    double Uniform();  // [0, 1)
-    double Normal();
-    Vec3 Normal3() { return Vec3(Normal(), Normal(), Normal()); }
-
-   private:
-    std::mt19937_64 engine_;
-  };
+  using Rng = SimRng;  // core/sim/sim_random.h
 
   // The next record of the whole drive (before the log_start cut); *from: the elapsed time the record
   // starts measuring at (its time, or the start of an encoder interval).

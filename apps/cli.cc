@@ -15,6 +15,7 @@
 #include "apps/report_command.h"
 #include "apps/run_command.h"
 #include "apps/stream_command.h"
+#include "apps/api/access.h"
 #include "config/config_loader.h"
 #include "core/io/log_reader.h"
 #include "core/sim/simulator.h"
@@ -150,6 +151,11 @@ int RunCli(int argc, const char* const* argv, bool own_process) {
                   "Truth CSV (docs/formats.md §4) for an accuracy summary; auto: the log's own, NAME.truth.csv[.gz] "
                   "beside NAME.txt[.gz], when there is one (docs/fleet.md)")
       ->check(CLI::ExistingFile | CLI::IsMember({"auto"}));
+  std::string obs_path, nav_path;
+  run->add_option("--obs", obs_path,
+                  "RINEX 3 observation file for tightly coupled GNSS (raw_gnss.obs_file; the log's time in GPS s)")
+      ->check(CLI::ExistingFile);
+  run->add_option("--nav", nav_path, "RINEX 3 navigation file (raw_gnss.nav_file)")->check(CLI::ExistingFile);
   bool strict = false;
   run->add_flag("--strict", strict,
                 "Exit 3 unless every estimator's health verdict is ok (degraded or failed: summary.json's health)");
@@ -192,7 +198,13 @@ int RunCli(int argc, const char* const* argv, bool own_process) {
   if (*exp) return RunExport(export_req);
   try {
     if (*run) {
-      const api::Config config = api::Config::FromFile(config_path);
+      api::Config config = api::Config::FromFile(config_path);
+      if (!obs_path.empty() || !nav_path.empty()) {
+        Options options = api::internal::Access::options(config);
+        if (!obs_path.empty()) options.gnss.raw.obs_file = obs_path;
+        if (!nav_path.empty()) options.gnss.raw.nav_file = nav_path;
+        config = api::internal::Access::MakeConfig(options);
+      }
       req.config_path = config_path;
       if (truth_path == "auto") truth_path = TruthBesideLog(req.log_path);
       if (!truth_path.empty()) req.truth_path = truth_path;

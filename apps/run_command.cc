@@ -180,6 +180,7 @@ nlohmann::json RunSummary(const Options& options, const RunRequest& request, con
   const nlohmann::json session_stats = api::internal::Access::stats(api_session);
   j["input"] = InputJson(rs, session, session_stats, api_session.status());
   j["initialization"] = session_stats["initialization"];
+  if (session_stats.contains("gnss_raw")) j["gnss_raw"] = session_stats["gnss_raw"];
   j["estimators"] = session_stats["estimators"];
   const double log_duration = session.last_time() - session.first_time();
   const double wall = Seconds(Clock::now() - wall_start);
@@ -266,7 +267,7 @@ void CheckInitTimeout(const std::string& name, double max_wait, const api::Sessi
                  api::internal::Access::session(session).Diagnosis());
 }
 
-void CheckReadCounts(const std::string& name, const ReadStats& rs) {
+void CheckReadCounts(const std::string& name, const ReadStats& rs, bool raw_gnss) {
   auto no_usable = [&](const std::string& what) {
     if (rs.lines == 0) return RunError(name + ": empty log (no lines)");
     std::string m = name + ": no usable " + what + " records (" + std::to_string(rs.lines) + " lines: " +
@@ -281,7 +282,7 @@ void CheckReadCounts(const std::string& name, const ReadStats& rs) {
     return RunError(m + ")");
   };
   if (rs.imu == 0) throw no_usable("IMU");
-  if (rs.gnss == 0) throw no_usable("GNSS");
+  if (rs.gnss == 0 && !raw_gnss) throw no_usable("GNSS");
 }
 
 void FinishSession(const std::string& name, api::Session* session) {
@@ -355,7 +356,7 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
       CheckInitTimeout(request.log_path, options.init.max_wait, session);
     }
   }
-  CheckReadCounts(request.log_path, read_stats);
+  CheckReadCounts(request.log_path, read_stats, !options.gnss.raw.obs_file.empty());
   FinishSession(request.log_path, &session);
   writer.Close();  // every state written (or the writer's error thrown) before the files are committed
   if (request.poll) request.poll();  // and after the two-sided passes Finish runs

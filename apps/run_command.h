@@ -83,8 +83,8 @@ class StateFilter {
 // RunError naming the log (`name`).
 void CheckInitTimeout(const std::string& name, double max_wait, const api::Session& session);
 // At the end of the data: a log without usable IMU or GNSS records, said in one line (what it held and its
-// first damaged line). Throws RunError.
-void CheckReadCounts(const std::string& name, const ReadStats& rs);
+// first damaged line; raw_gnss: no GNSS records needed, raw observations stand in). Throws RunError.
+void CheckReadCounts(const std::string& name, const ReadStats& rs, bool raw_gnss);
 // Finish() on the session; a session that never initialised is a RunError naming the log.
 void FinishSession(const std::string& name, api::Session* session);
 

@@ -73,6 +73,24 @@ inline constexpr auto kGnssKeys = [](auto& v, GnssOptions& o) {
   v.PeriodicOutages("periodic_outages_s", o.periodic_outages);
 };
 
+inline constexpr auto kRawGnssInputKeys = [](auto& v, GnssRawOptions& o) {
+  v.String("obs_file", o.obs_file);
+  v.String("nav_file", o.nav_file);
+  v.Number("elevation_mask_deg", o.elevation_mask, kDeg, Within(0.0, 60.0));
+  using Iono = GnssRawOptions::Ionosphere;
+  v.Choice("ionosphere", o.ionosphere,
+           Choices<Iono>{{"auto", Iono::kAuto},
+                         {"klobuchar", Iono::kKlobuchar},
+                         {"iono_free", Iono::kIonosphereFree},
+                         {"none", Iono::kNone}});
+  v.Number("code_sigma_m", o.code_sigma, kNoUnit, Positive());
+  v.Number("doppler_sigma_m_s", o.doppler_sigma, kNoUnit, Positive());
+  v.Boolean("use_doppler", o.use_doppler);
+  v.Boolean("use_phase", o.use_phase);
+  v.Number("phase_sigma_m", o.phase_sigma, kNoUnit, Positive());
+  v.Number("init_max_attitude_sigma_deg", o.init_max_attitude_sigma, kDeg, Within(0.01, 30.0));
+};
+
 inline constexpr auto kWheelKeys = [](auto& v, WheelOptions& o) {
   v.Boolean("enabled", o.enabled);
   v.Number("radius_m", o.radius, kNoUnit, Positive());
@@ -236,6 +254,7 @@ inline constexpr auto kOptionsKeys = [](auto& v, Options& o) {
   v.Section("input", o.input, kInputKeys);
   v.Section("imu", o.imu, kImuKeys);
   v.Section("gnss", o.gnss, kGnssKeys);
+  v.Section("raw_gnss", o.gnss.raw, kRawGnssInputKeys);
   v.Section("wheel", o.wheel, kWheelKeys);
   v.Section("vehicle", o.vehicle, kVehicleKeys);
   v.Section("gravity", o.gravity, kGravityKeys);

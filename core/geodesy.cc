@@ -1,6 +1,7 @@
 #include "core/geodesy.h"
 
 #include <GeographicLib/Constants.hpp>
+#include <GeographicLib/Geocentric.hpp>
 #include <GeographicLib/LocalCartesian.hpp>
 #include <GeographicLib/NormalGravity.hpp>
 #include <cmath>
@@ -34,6 +35,22 @@ GeodeticPoint LocalEnuFrame::ToGeodetic(const Vec3& p_w) const {
   GeodeticPoint g;
   proj_->Reverse(p_w.x(), p_w.y(), p_w.z(), g.lat_deg, g.lon_deg, g.alt_m);
   return g;
+}
+
+Vec3 LocalEnuFrame::OriginEcef() const {
+  Vec3 r;
+  GeographicLib::Geocentric::WGS84().Forward(origin_.lat_deg, origin_.lon_deg, origin_.alt_m, r.x(), r.y(), r.z());
+  return r;
+}
+
+Mat3 LocalEnuFrame::R_ecef_w() const {
+  // Geocentric's M takes local ENU components into ECEF (row-major).
+  std::vector<double> M(9);
+  double x, y, z;
+  GeographicLib::Geocentric::WGS84().Forward(origin_.lat_deg, origin_.lon_deg, origin_.alt_m, x, y, z, M);
+  Mat3 R;
+  R << M[0], M[1], M[2], M[3], M[4], M[5], M[6], M[7], M[8];
+  return R;
 }
 
 Mat3 LocalEnuFrame::RotationFromLocalEnu(const GeodeticPoint& p) const {

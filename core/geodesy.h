@@ -31,6 +31,9 @@ class LocalEnuFrame {
   // R_w_l: takes vectors in the local ENU frame at p (e.g. a truth file's attitude or velocity) into w.
   // Differs from identity by about distance / Earth radius (0.01° at 1 km).
   Mat3 RotationFromLocalEnu(const GeodeticPoint& p) const;
+  // w is the ENU tangent frame at the origin, so r_ecef = OriginEcef() + R_ecef_w()·p_w exactly (WGS 84).
+  Vec3 OriginEcef() const;
+  Mat3 R_ecef_w() const;
 
  private:
   GeodeticPoint origin_;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -25,6 +26,25 @@ struct ImuOptions {
   double max_gap = 0.5;                // imu.max_gap_s: a longer IMU gap is not integrated across
   double max_gyro = 35.0;              // imu.max_gyro_rad_s: larger readings are absurd (damage)
   double max_acc = 200.0;              // imu.max_acc_m_s2
+};
+
+// raw_gnss.*: raw observations (RINEX 3) for the tightly coupled updates (core/gnss_raw.h).
+struct GnssRawOptions {
+  std::string obs_file;  // raw_gnss.obs_file: RINEX 3 observation file ("": none); `gins run --obs`
+  std::string nav_file;  // raw_gnss.nav_file: RINEX 3 navigation file; `gins run --nav`
+  double elevation_mask = 15.0 * kDegToRad;  // raw_gnss.elevation_mask_deg
+  // raw_gnss.ionosphere: auto (the ionosphere-free combination where a satellite has two codes, else
+  // Klobuchar where the navigation file gives GPSA/GPSB, else none) | klobuchar | iono_free | none.
+  enum class Ionosphere { kAuto, kKlobuchar, kIonosphereFree, kNone };
+  Ionosphere ionosphere = Ionosphere::kAuto;
+  double code_sigma = 0.3;     // raw_gnss.code_sigma_m: pseudorange σ² = a² + b²/sin²(el), a = b = this
+  double doppler_sigma = 0.1;  // raw_gnss.doppler_sigma_m_s: range-rate σ = this·(1 + 1/sin el)
+  bool use_doppler = true;      // raw_gnss.use_doppler
+  bool use_phase = true;        // raw_gnss.use_phase: time-differenced carrier phase between epochs
+  double phase_sigma = 0.003;   // raw_gnss.phase_sigma_m: its σ = this·(1 + 1/sin el)
+  // raw_gnss.init_max_attitude_sigma_deg: the initialisation's acceptance when raw epochs initialise (the
+  // larger of it and init.max_attitude_sigma_deg).
+  double init_max_attitude_sigma = 10.0 * kDegToRad;
 };
 
 // gnss.*
@@ -61,6 +81,7 @@ struct GnssOptions {
     double period = 0.0;       // s, start to start
   };
   PeriodicOutages periodic_outages;  // gnss.periodic_outages_s: [first_start_s, duration_s, period_s] or []
+  GnssRawOptions raw;                // raw_gnss (its own section)
 };
 
 // wheel.*

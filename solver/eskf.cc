@@ -33,6 +33,7 @@ Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state, StateCallbac
     : options_(options), on_state_(std::move(on_state)), on_rts_(std::move(on_rts)), watchdog_(options.watchdog) {
   gate_gnss_ = Chi2Gate(options_.gnss.gate_probability, 3);
   gate_heading_ = Chi2Gate(options_.gnss.gate_probability, 1);
+  raw_.w_max = std::sqrt(gate_heading_);
   gate_wheel_ = Chi2Gate(options_.wheel.gate_probability, 1);
   gate_nhc_ = Chi2Gate(options_.wheel.gate_probability, 2);
   gate_wheel_yaw_ = Chi2Gate(options_.wheel.gate_probability, 1);
@@ -294,6 +295,7 @@ bool Eskf::Update(const Model<M>& model, const Eigen::Matrix<double, M, M>& R, d
   MatPM K = llt.solve(PHt.transpose()).transpose();
   VecP e = -K * lin.r;
   for (int it = 1;; ++it) {
+    position_corrections_ += eskf::SegmentOf<Block::kP>(e);
     nom_.PlusInPlace(e);
     // Converged when the step is below 1 % of the σ of every state.
     const bool small = (e.array().abs() <= 0.01 * Pi.diagonal().array().sqrt()).all();
@@ -342,6 +344,8 @@ template bool Eskf::Update<2>(const Model<2>&, const Eigen::Matrix<double, 2, 2>
                               double, Eigen::Matrix<double, 2, 1>*, Eigen::Matrix<double, 2, 2>*);
 template bool Eskf::Update<3>(const Model<3>&, const Eigen::Matrix<double, 3, 3>&, double, MeasurementCounts*, double,
                               double, Eigen::Matrix<double, 3, 1>*, Eigen::Matrix<double, 3, 3>*);
+template bool Eskf::Update<Eigen::Dynamic>(const Model<Eigen::Dynamic>&, const MatX&, double, MeasurementCounts*,
+                                           double, double, VecX*, MatX*);
 
 bool Eskf::WatchGnss(const GnssMeasurement& m, bool accepted) {
   if (!watchdog_.Watch(m.t, accepted)) return false;
@@ -364,6 +368,7 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
     SetAdditivePriors();
   }
   const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &nom_.x, P_, course_wait_.Take());
+  phase_epoch_.valid = false;  // the position jumped: no displacement to difference across
   P_ = 0.5 * (P_ + P_.transpose());
   gyro_sum_.setZero();
   gyro_count_ = 0;
@@ -394,6 +399,7 @@ nlohmann::json Eskf::Stats() const {
   j["gnss_position"] = gnss_counts_.ToJson();
   j["gnss_heading"] = heading_counts_.ToJson();
   j["gnss_velocity"] = gnss_velocity_counts_.ToJson();
+  if (raw_.epochs > 0) j["gnss_raw"] = raw_.ToJson();
   j["wheel"] = wheel_counts_.ToJson();
   j["wheel_yaw_rate"] = wheel_yaw_counts_.ToJson();
   j["nonholonomic"] = nhc_counts_.ToJson();

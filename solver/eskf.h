@@ -28,6 +28,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <initializer_list>
 #include <memory>
 #include <optional>
@@ -62,6 +63,7 @@ class Eskf : public Estimator {
   void AddGnssVelocity(const GnssVelocityMeasurement& gnss_velocity) override;
   void AddWheel(const WheelMeasurement& wheel) override;
   void AddStandstill(const StandstillMeasurement& m) override;
+  void AddRawGnss(const RawGnssMeasurement& m) override;
   void AddRestState(const StateEstimate& s) override;
   void Finish() override;
   nlohmann::json Stats() const override;
@@ -123,6 +125,10 @@ class Eskf : public Estimator {
   void UpdateWheelSpeed(const WheelMeasurement& m);
   void UpdateWheelYawRate(const WheelMeasurement& m);
   void UpdateNonHolonomic(double t);
+  // The tightly coupled updates (eskf_raw_gnss.cc): the epoch's pseudoranges, or its range rates.
+  void UpdateRawGnss(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats, bool rates);
+  // The carrier phases' time differences since the previous epoch; then that epoch becomes this one.
+  void UpdateRawPhase(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats);
   // Watchdog: after a GNSS position update (accepted or not); returns true if it re-initialised.
   bool WatchGnss(const GnssMeasurement& m, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
@@ -169,6 +175,28 @@ class Eskf : public Estimator {
   ImuGapLog imu_gaps_;
   MeasurementCounts gnss_counts_, heading_counts_, gnss_velocity_counts_, wheel_counts_, wheel_yaw_counts_, nhc_counts_,
       zupt_counts_;
+
+  // Raw GNSS (eskf_raw_gnss.cc): the epochs' updates, and each satellite's fate.
+  struct RawGnssCounts {
+    uint64_t epochs = 0, satellites_used = 0, unusable = 0, epochs_without_differences = 0;
+    MeasurementCounts ranges, rates, phases;
+    uint64_t phase_slips = 0;  // satellites left out of a difference: lost lock, or a jump against the Doppler
+    std::map<std::string, uint64_t> satellite_rejected;  // "G05" -> epochs its own test rejected it
+    double w_max = 0.0;  // the standardised residual's bound: √χ²(gnss.gate_probability, 1)
+    nlohmann::json ToJson() const;
+  };
+  RawGnssCounts raw_;
+  // The previous epoch for the phases' time differences: its satellites, the nominal antenna then, and the
+  // updates' corrections of the nominal position since (the propagation alone gives the displacement).
+  struct PhaseEpoch {
+    bool valid = false;
+    double t = 0.0;
+    Vec3 p_wb = Vec3::Zero();
+    Quat q_wb = Quat::Identity();
+    std::map<std::string, RawSatellite> sats;  // by "G05"
+  };
+  PhaseEpoch phase_epoch_;
+  Vec3 position_corrections_ = Vec3::Zero();
 
   GnssWatchdog watchdog_;
   std::optional<GnssMeasurement> prev_fix_;  // the fix before the current one, accepted or not

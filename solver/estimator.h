@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/gnss_raw.h"
 #include "core/initializer.h"
 #include "core/measurements.h"
 #include "core/nav_state.h"
@@ -39,6 +40,9 @@ class Estimator {
   // The vehicle stands (the session's detector: wheels at zero and IMU quiet, or IMU quiet without
   // wheels); sent at most every 0.1 s while it stands, right after the IMU sample at m.t.
   virtual void AddStandstill(const StandstillMeasurement& m) = 0;
+  // A raw GNSS epoch (core/gnss_raw.h), in time order with the rest; it carries its own single-point fix for
+  // an estimator that takes fixes only.
+  virtual void AddRawGnss(const RawGnssMeasurement& m) = 0;
   // Before Initialize: a state at rest that the initialiser knows without a yaw (Initializer::RestStates),
   // in time order and before the initialisation's time; written to the forward outputs, and to the
   // two-sided ones with the yaw found later (solver/pre_init_output.h).

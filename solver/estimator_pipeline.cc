@@ -2,6 +2,7 @@
 
 #include <glog/logging.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <condition_variable>
@@ -144,7 +145,15 @@ void EstimatorPipeline::EnsureInitializer() {
   if (init_ || !frame_) return;
   earth_ = EarthModel::FromOptions(*frame_, options_.gravity);
   g_norm_ = earth_.g_norm();
-  init_ = std::make_unique<Initializer>(options_, earth_);
+  if (raw_feed_ || raw_.epochs > 0) {
+    // Raw GNSS: the Dopplers and carrier phases pin the yaw within seconds of the start, while single-point
+    // fixes would hold a 1° acceptance for a minute (docs/estimators.md, "Tightly coupled GNSS").
+    EstimatorOptions o = options_;
+    o.init.max_attitude_sigma = std::max(o.init.max_attitude_sigma, o.gnss.raw.init_max_attitude_sigma);
+    init_ = std::make_unique<Initializer>(o, earth_);
+  } else {
+    init_ = std::make_unique<Initializer>(options_, earth_);
+  }
   standstill_ = std::make_unique<StandstillDetector>(options_.standstill, g_norm_, options_.wheel.interval);
   // Replay what arrived before the world frame existed, in time order.
   size_t i = 0, j = 0;
@@ -191,6 +200,7 @@ void EstimatorPipeline::WatchImuInterval(double t) {
 }
 
 void EstimatorPipeline::AddImu(const ImuSample& raw) {
+  DrainRawGnss(raw.t);
   Touch(raw.t);
   WatchImuInterval(raw.t);
   ImuSample s = raw;
@@ -285,6 +295,7 @@ void EstimatorPipeline::DetectStandstill(double t) {
 }
 
 void EstimatorPipeline::AddWheel(const WheelRecord& o) {
+  DrainRawGnss(o.t);
   Touch(o.t);
   if (!options_.wheel.enabled) {
     ++odom_ignored_;
@@ -341,8 +352,13 @@ WheelMeasurement EstimatorPipeline::WheelFromOdom(const WheelRecord& o) {
 }
 
 void EstimatorPipeline::AddGnss(const GnssRecord& g) {
+  DrainRawGnss(g.t);
   Touch(g.t);
   if (DropForSimulatedOutage(g.t)) return;
+  UseFix(g, nullptr);
+}
+
+void EstimatorPipeline::UseFix(const GnssRecord& g, const RawGnssMeasurement* raw) {
   if (!frame_) frame_.emplace(GeodeticPoint{g.lat_deg, g.lon_deg, g.alt_m});
   EnsureInitializer();
   last_fix_geo_ = GeodeticPoint{g.lat_deg, g.lon_deg, g.alt_m};
@@ -381,12 +397,18 @@ void EstimatorPipeline::AddGnss(const GnssRecord& g) {
     } else {
       SendRestStates();
     }
+  } else if (raw != nullptr) {
+    RawGnssMeasurement with_fix = *raw;
+    with_fix.has_fix = true;
+    with_fix.fix = m;
+    Dispatch(&Estimator::AddRawGnss, with_fix);
   } else {
     Dispatch(&Estimator::AddGnss, m);
   }
 }
 
 void EstimatorPipeline::AddGnssVelocity(const GnssVelocityRecord& g) {
+  DrainRawGnss(g.t);
   Touch(g.t);
   const bool in_outage = initialized_ && !outage_schedule_.empty() && outage_schedule_.Contains(g.t, first_t_);
   if (!options_.gnss.use_velocity || !last_fix_geo_ || !init_ || in_outage) {
@@ -424,6 +446,7 @@ std::string EstimatorPipeline::Diagnosis() const {
 }
 
 void EstimatorPipeline::Finish() {
+  FinishRawGnss();
   if (!initialized_) throw RunError(Diagnosis());
   DispatchTask([](Estimator& e) { e.Finish(); });
   StopWorkers();

@@ -6,7 +6,9 @@
 #pragma once
 
 #include <chrono>
+#include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -25,6 +27,7 @@
 #include "core/initializer.h"
 #include "solver/estimator.h"
 #include "solver/estimator_options.h"
+#include "solver/raw_gnss_feed.h"
 
 namespace gins {
 
@@ -53,6 +56,13 @@ class EstimatorPipeline {
   void AddWheel(const WheelRecord& wheel);
   void AddGnss(const GnssRecord& fix);
   void AddGnssVelocity(const GnssVelocityRecord& vel);
+  // Raw GNSS epochs (solver/raw_gnss_feed.h): from a feed, merged into the records by time (each Add* first
+  // takes the feed's epochs dated up to its record's time, on GPS time: the tag less the receiver clock of
+  // the epoch's fix, or of the last fix; Finish the rest), or given one by one, in time order. Each epoch's
+  // single-point fix sets the world frame and initialises like a fix; then the epoch goes to every
+  // estimator (Estimator::AddRawGnss), with that fix when it has one (estimator_pipeline_raw.cc).
+  void SetRawGnssFeed(std::unique_ptr<RawGnssFeed> feed);
+  void AddRawGnss(RawGnssMeasurement m);
   // A log's record (or a simulated one) to the Add* of its type: the one dispatch before the estimators.
   void Add(const LogRecord& r);
   // End of the data: flushes the estimators. Throws RunError if initialisation never completed.
@@ -74,6 +84,40 @@ class EstimatorPipeline {
  private:
   void Touch(double t);
   void EnsureInitializer();
+  // A fix in w to the initialiser or the estimators (with its raw epoch, if it comes from one).
+  void UseFix(const GnssRecord& g, const RawGnssMeasurement* raw);
+  void DrainRawGnss(double t) {
+    if (raw_feed_ && !draining_raw_) DrainRawFeed(t);
+  }
+  void DrainRawFeed(double t);
+  void FinishRawGnss();
+  nlohmann::json RawGnssStats() const;
+  std::unique_ptr<RawGnssFeed> raw_feed_;
+  bool draining_raw_ = false;
+  // An epoch with its single-point fix, dated on GPS time (m.t), waiting for the records to reach it.
+  struct PreparedRawGnss {
+    RawGnssMeasurement m;
+    SppSolution sol;
+  };
+  PreparedRawGnss PrepareRawGnss(RawGnssMeasurement m);
+  void UseRawGnss(PreparedRawGnss p);
+  std::deque<PreparedRawGnss> raw_queue_;
+  std::optional<double> last_clock_m_;  // the receiver clock of the last fix (× c, m)
+  struct RawCounts {
+    uint64_t epochs = 0, before_log = 0, in_outage = 0, without_fix = 0, without_velocity = 0, used_before_init = 0;
+    std::map<std::string, uint64_t> fix_failures;  // the single-point fix's reason
+  };
+  RawCounts raw_;
+  // Inter-system biases (RawGnssMeasurement::inter_system_bias): Welford's mean and spread of each system's
+  // clock less GPS's (else the first system's) over the single-point fixes.
+  struct BiasMean {
+    uint64_t n = 0;
+    double mean = 0.0, m2 = 0.0;
+  };
+  std::map<GnssSystem, BiasMean> isb_;
+  std::optional<GnssSystem> isb_reference_;
+  void TrackInterSystemBias(const SppSolution& sol, RawGnssMeasurement* m);
+  std::optional<Vec3> last_spp_ecef_;
   // Hands a copy of the measurement to every estimator (a member function of Estimator taking it).
   template <typename M>
   void Dispatch(void (Estimator::*add)(const M&), const M& m);

@@ -17,6 +17,7 @@ nlohmann::json EstimatorPipeline::Stats() const {
   j[k::kWheelGaps] = wheel_gaps_;
   j[k::kDroppedBeforeFirstFix] = pending_dropped_;
   j["standstill_updates"] = standstill_sent_;
+  if (raw_feed_ || raw_.epochs > 0) j["gnss_raw"] = RawGnssStats();
   j[k::kRestStatesBeforeInitialization] = rest_sent_;
   if (!imu_warning_.empty()) j["warnings"] = {imu_warning_};
   if (options_.vehicle.nonholonomic) {

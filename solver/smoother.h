@@ -61,6 +61,12 @@ class Smoother : public Estimator {
   void AddGnssVelocity(const GnssVelocityMeasurement& gnss_velocity) override;
   void AddWheel(const WheelMeasurement& wheel) override;
   void AddStandstill(const StandstillMeasurement& m) override;
+  // The epoch's single-point fix and Doppler velocity, as a fix and a GNSS velocity: the smoother has no
+  // raw updates yet.
+  void AddRawGnss(const RawGnssMeasurement& m) override {
+    if (m.has_fix) AddGnss(m.fix);
+    if (m.has_velocity && options_.gnss.use_velocity) AddGnssVelocity(m.velocity);
+  }
   void AddRestState(const StateEstimate& s) override;
   void Finish() override;
   nlohmann::json Stats() const override;

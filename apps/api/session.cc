@@ -74,6 +74,16 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
       wheel_clock_(options_.imu.max_gap + options_.wheel.interval),
       imu_range_(ReaderOptions(options_).imu_range) {
   session_.SetParallel(session_options_.parallel);
+  if (!options_.gnss.raw.obs_file.empty() || !options_.gnss.raw.nav_file.empty()) {
+    if (options_.gnss.raw.obs_file.empty() || options_.gnss.raw.nav_file.empty()) {
+      throw Error(Error::Kind::kConfig, "raw_gnss: obs_file and nav_file go together (gins run --obs OBS --nav NAV)");
+    }
+    try {
+      session_.SetRawGnssFeed(std::make_unique<RawGnssFeed>(options_.gnss.raw, options_.input));
+    } catch (const InputError& e) {
+      throw Error(Error::Kind::kInput, e.what());
+    }
+  }
   const Mode mode = session_options_.mode;
   const bool all = mode == Mode::kAll;
   if (mode == Mode::kEskf || mode == Mode::kBoth || all) {
@@ -108,6 +118,8 @@ bool Session::Impl::Push(LogRecord record) {
     if (!reorder_.Add(record, [this](const LogRecord& r) { Dispatch(r); })) return Reject(record.type, "late");
   } catch (const RunError& e) {
     throw Error(Error::Kind::kInput, e.what());  // the data cannot be used as they are (core/imu_checks.h)
+  } catch (const InputError& e) {
+    throw Error(Error::Kind::kInput, e.what());  // the raw GNSS files (raw_gnss), read as the log goes
   }
   ++accepted_;
   RethrowCallbackError();
@@ -124,6 +136,8 @@ void Session::Impl::Finish() {
     session_.Finish();
   } catch (const RunError& e) {
     throw Error(Error::Kind::kNoSolution, e.what());
+  } catch (const InputError& e) {
+    throw Error(Error::Kind::kInput, e.what());
   }
   RethrowCallbackError();
 }

@@ -183,6 +183,7 @@ class Recorder : public Estimator {
   void AddImu(const ImuSample& imu) override { inputs_->emplace_back(imu); }
   void AddGnss(const GnssMeasurement& gnss) override { inputs_->emplace_back(gnss); }
   void AddGnssVelocity(const GnssVelocityMeasurement&) override {}  // the step drive has no GNSS velocity
+  void AddRawGnss(const RawGnssMeasurement&) override {}            // nor raw observations
   void AddWheel(const WheelMeasurement& wheel) override { inputs_->emplace_back(wheel); }
   void AddStandstill(const StandstillMeasurement& m) override { inputs_->emplace_back(m); }
   void AddRestState(const StateEstimate&) override {}

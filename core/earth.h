@@ -45,6 +45,13 @@ class EarthModel {
   Vec3 Gravity(const Vec3& p_w) const;
   // |g| at the origin (for the summary and the flat model).
   double g_norm() const { return g_norm_; }
+  // The same Earth for a mechanisation run backwards in time (t' = −t, v' = −v, ω' = −ω): the rotation's
+  // terms (Coriolis, the frame's turn) change sign, gravity with its centrifugal part does not.
+  EarthModel TimeReversed() const {
+    EarthModel e = *this;
+    e.rate_w_ = -rate_w_;
+    return e;
+  }
 
   // Distance from the linearisation centre beyond which Gravity recomputes it (m).
   static constexpr double kRefreshDistance = 500.0;

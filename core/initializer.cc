@@ -89,6 +89,7 @@ void Initializer::AddImu(const ImuSample& imu) {
     last_standstill_.reset();
   }
   imu_.push_back(imu);
+  history_imu_.push_back(imu);
   detector_.AddImu(imu);
   TrackStandstill(imu);
   Prune(imu.t);
@@ -112,6 +113,9 @@ void Initializer::Prune(double t) {
   while (!fixes_.empty() && t - fixes_.front().t > keep) fixes_.pop_front();
   while (!gnss_velocities_.empty() && t - gnss_velocities_.front().t > keep) gnss_velocities_.pop_front();
   while (!wheels_.empty() && t - wheels_.front().t > keep) wheels_.pop_front();
+  const double keep_history = options_.init.max_wait + kMaxWindow;
+  while (!history_imu_.empty() && t - history_imu_.front().t > keep_history) history_imu_.pop_front();
+  while (!history_fixes_.empty() && t - history_fixes_.front().t > keep_history) history_fixes_.pop_front();
 }
 
 void Initializer::Summarize(Standstill* st) {
@@ -183,6 +187,7 @@ void Initializer::CloseStandstill() {
 void Initializer::AddGnss(const GnssMeasurement& fix) {
   if (done()) return;
   fixes_.push_back(fix);
+  history_fixes_.push_back(fix);
   detector_.AddGnss(fix);
   if (imu_.empty()) {
     last_problem_ = "no IMU sample yet";
@@ -350,6 +355,15 @@ void Initializer::Finish(const AlignmentFit& a, const GnssMeasurement& fix, cons
   r.fit_start_P = 0.5 * (a.P0 + a.P0.transpose());
   for (int b = 0; b < 5; ++b) r.fit_start_P.block<3, 3>(3 * b, 3 * b).diagonal().array() += floors[b] * floors[b];
   r.fit_imu = std::move(fit_imu);
+  const double first_fix = history_fixes_.empty() ? r.x0.t : history_fixes_.front().t;
+  for (const ImuSample& sample : history_imu_) {
+    if (sample.t >= first_fix - 1e-6 && sample.t < r.x0.t) r.pre_init_imu.push_back(sample);
+  }
+  for (const GnssMeasurement& f : history_fixes_) {
+    if (f.t < r.x0.t) r.pre_init_fixes.push_back(f);
+  }
+  history_imu_.clear();
+  history_fixes_.clear();
   r.chi2_per_dof = a.chi2 / std::max(1, a.dof);
   r.inflation = a.inflation;
   r.runner_up_delta_chi2 = a.runner_up_delta_chi2;

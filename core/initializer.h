@@ -25,7 +25,8 @@
 // position of the standstill's fixes, a zero velocity, roll and pitch from gravity, and the yaw from the
 // Earth's rotation when the gyro's stated bias σ resolves it (gyrocompassing: tactical and navigation-grade
 // IMUs), else a yaw of 0 with the σ of a uniformly unknown angle (π/√3); the two-sided outputs later give
-// those epochs the yaw found from the motion (solver/pre_init_output.h).
+// those epochs the yaw found from the motion (solver/pre_init_output.h). Everything since the first fix goes
+// with the result (InitResult::pre_init_*) for the backward runs there.
 #pragma once
 
 #include <deque>
@@ -77,6 +78,10 @@ struct InitResult {
   NavState fit_start;             // the fit's state there (at window_start) and its covariance
   Mat15 fit_start_P = Mat15::Identity();
   std::vector<ImuSample> fit_imu;  // the fit's IMU samples (body axes), from window_start to x0.t
+  // Everything since the first fix, for the backward runs before the initialisation
+  // (solver/pre_init_backward.h): the IMU samples and the fixes before x0.t.
+  std::vector<ImuSample> pre_init_imu;
+  std::vector<GnssMeasurement> pre_init_fixes;
   double chi2_per_dof = 0.0, inflation = 1.0, runner_up_delta_chi2 = 0.0;
 };
 
@@ -146,6 +151,10 @@ class Initializer {
   std::deque<GnssVelocityMeasurement> gnss_velocities_;
   std::deque<WheelMeasurement> wheels_;
   double first_time_ = -1.0;
+  // The IMU samples and fixes of the last init.max_wait_s plus the longest window: InitResult's pre_init_*
+  // (from the first fix on).
+  std::deque<ImuSample> history_imu_;
+  std::deque<GnssMeasurement> history_fixes_;
   std::optional<Standstill> standing_;  // the current standstill
   std::optional<Standstill> last_standstill_;  // the latest one that ended
   double last_attempt_ = -1e300;

@@ -39,6 +39,7 @@ Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state, StateCallbac
   gate_wheel_yaw_ = Chi2Gate(options_.wheel.gate_probability, 1);
   gate_zupt_ = Chi2Gate(options_.wheel.gate_probability, 3);
   gate_zero_rate_ = Chi2Gate(kZeroRateGateProbability, 3);
+  pre_init_.SetBackwardFiller([this](const BackwardSpan& span) { return FillBackward(options_, span); });
 }
 
 Eskf::~Eskf() = default;
@@ -51,7 +52,7 @@ void Eskf::Finish() {
   rts_->Smooth(earth_, pre_init_.TwoSided(on_rts_));
 }
 
-void Eskf::AddRestState(const StateEstimate& s) { pre_init_.Add(s, on_rts_ != nullptr, on_state_); }
+void Eskf::AddRestState(const StateEstimate& s) { pre_init_.Add(s, on_state_); }
 
 void Eskf::Initialize(const InitResult& init) {
   pre_init_.Start(init, on_state_);

@@ -21,6 +21,19 @@ StateEstimate EstimateOf(const NavState& x, const Mat15& P) {
   return e;
 }
 
+// A covariance for a state known only by its σ (world axes): those on the diagonal, the biases' blocks
+// taken from P (the fit's: the two-sided pass reports no bias σ).
+Mat15 CovarianceOf(const StateEstimate& s, const Mat15& P) {
+  Mat15 C = Mat15::Zero();
+  C.block<3, 3>(nav::kP, nav::kP) = s.sigma_p.cwiseAbs2().asDiagonal();
+  C.block<3, 3>(nav::kV, nav::kV) = s.sigma_v.cwiseAbs2().asDiagonal();
+  const Mat3 R_wb = s.x.R_wb();
+  const Mat3 att_w = s.sigma_att.cwiseAbs2().asDiagonal();
+  C.block<3, 3>(nav::kTheta, nav::kTheta) = R_wb.transpose() * att_w * R_wb;  // right perturbation: body axes
+  C.block<6, 6>(nav::kBg, nav::kBg) = P.block<6, 6>(nav::kBg, nav::kBg);
+  return C;
+}
+
 ImuEarthTerms TermsAt(const EarthModel& earth, const Vec3& p_w) {
   ImuEarthTerms terms;
   terms.g_w = earth.Gravity(p_w);
@@ -30,22 +43,51 @@ ImuEarthTerms TermsAt(const EarthModel& earth, const Vec3& p_w) {
 
 }  // namespace
 
-void PreInitOutput::Add(const StateEstimate& s, bool keep, const StateCallback& forward,
-                        const StateCallback& forward2) {
+void PreInitOutput::Add(const StateEstimate& s, const StateCallback& forward, const StateCallback& forward2) {
+  // After the first standstill the vehicle moved, with no attitude yet: what follows is written at the
+  // initialisation, from the backward run, in time order.
+  if (!rest_times_.empty() && s.x.t - rest_times_.back() > kBreak) first_standstill_over_ = true;
+  rest_times_.push_back(s.x.t);
+  if (first_standstill_over_) return;
   if (forward) forward(s);
   if (forward2) forward2(s);
   last_forward_t_ = s.x.t;
-  if (keep) kept_.push_back({s.x.t, s.sigma_v});
+}
+
+BackwardSpan PreInitOutput::Span(double from, double to) const {
+  BackwardSpan span;
+  span.from = from;
+  span.earth = earth_;
+  for (const ImuSample& s : pre_init_imu_) {
+    if (s.t >= from && s.t < to) span.imu.push_back(s);
+  }
+  for (const GnssMeasurement& f : pre_init_fixes_) {
+    if (f.t >= from && f.t < to) span.fixes.push_back(f);
+  }
+  // The standstills: runs of rest epochs (one per IMU sample).
+  for (double t : rest_times_) {
+    if (t < from) continue;
+    if (t >= to - kSameTime) break;
+    if (!span.rests.empty() && t - span.rests.back().second <= kBreak) {
+      span.rests.back().second = t;
+    } else {
+      span.rests.push_back({t, t});
+    }
+  }
+  return span;
 }
 
 void PreInitOutput::Start(const InitResult& init, const StateCallback& forward, const StateCallback& forward2) {
   if (started_) return;  // a watchdog's re-initialisation: the log's start is written already
   started_ = true;
-  from_standstill_ = init.start == "standstill";
-  static_start_ = init.static_start;
   fit_start_ = init.fit_start;
   fit_end_ = init.x0;
   earth_ = init.earth;
+  if (backward_) {
+    P0_ = init.P0;
+    pre_init_imu_ = init.pre_init_imu;
+    pre_init_fixes_ = init.pre_init_fixes;
+  }
   steps_.clear();
   const std::vector<ImuSample>& imu = init.fit_imu;
   for (size_t i = 1; i < imu.size(); ++i) {
@@ -53,8 +95,20 @@ void PreInitOutput::Start(const InitResult& init, const StateCallback& forward, 
   }
   // The window's last sample may precede the completing fix: its reading is held up to it.
   if (!imu.empty() && fit_end_.t - imu.back().t > kSameTime) steps_.push_back({imu.back(), fit_end_.t - imu.back().t});
-  if (steps_.empty() || imu.front().t != fit_start_.t || (!forward && !forward2)) return;
+  if (!forward && !forward2) return;
   const StateEstimate a = EstimateOf(fit_start_, init.fit_start_P), b = EstimateOf(fit_end_, init.P0);
+  // What came after the last state written, up to the fit's start, run backwards from there.
+  if (backward_) {
+    BackwardSpan span = Span(last_forward_t_ + kSameTime, fit_start_.t);
+    span.start = a;
+    span.P = init.fit_start_P;
+    for (const StateEstimate& s : backward_(span)) {
+      if (forward) forward(s);
+      if (forward2) forward2(s);
+      last_forward_t_ = s.x.t;
+    }
+  }
+  if (steps_.empty() || imu.front().t != fit_start_.t) return;
   const double after = last_forward_t_ + kSameTime;
   EmitBridge(a, &b, steps_, TermsAt(earth_, a.x.p_wb), noise_, false, [&](const StateEstimate& s) {
     if (s.x.t <= after || s.x.t >= fit_end_.t - kSameTime) return;
@@ -63,45 +117,21 @@ void PreInitOutput::Start(const InitResult& init, const StateCallback& forward, 
   });
 }
 
-StateEstimate PreInitOutput::Carried(const StateEstimate& first, const NavState& fit_start, const NavState& fit_end) {
-  const Quat q_fix = (first.x.q_wb * fit_end.q_wb.conjugate()).normalized();
-  StateEstimate e = first;
-  e.x.t = fit_start.t;
-  e.x.q_wb = (first.x.q_wb * (fit_end.q_wb.conjugate() * fit_start.q_wb)).normalized();
-  e.x.p_wb = first.x.p_wb - q_fix * (fit_end.p_wb - fit_start.p_wb);
-  e.x.v_w = q_fix * fit_start.v_w;
-  return e;
-}
-
 StateCallback PreInitOutput::TwoSided(const StateCallback& out) const {
-  if (!out || !started_) return out;
-  // The rest epochs of the initialisation's standstill, before the fit starts.
-  auto epochs = std::make_shared<std::vector<Epoch>>();
-  if (from_standstill_) {
-    for (const Epoch& e : kept_) {
-      if (e.t >= static_start_ - kSameTime && e.t < fit_start_.t - kSameTime) epochs->push_back(e);
-    }
-  }
-  const bool bridge = !steps_.empty() && fit_end_.t - fit_start_.t > kSameTime;
-  if (epochs->empty() && !bridge) return out;
+  if (!out || !started_ || !backward_ || pre_init_fixes_.empty()) return out;
+  // Everything before the first state, from the first fix on, run backwards from it.
+  auto span = std::make_shared<BackwardSpan>(Span(pre_init_fixes_.front().t, fit_end_.t));
   auto pending = std::make_shared<bool>(true);
-  auto steps = std::make_shared<const std::vector<HeldImuSample>>(steps_);
-  const NavState fit_start = fit_start_, fit_end = fit_end_;
-  const EarthModel earth = earth_;
-  const BridgeNoise noise = noise_;
+  const BackwardFiller filler = backward_;
+  const Mat15 P0 = P0_;
+  const double t_first = fit_end_.t;
   return [=](const StateEstimate& s) {
     if (*pending) {
       *pending = false;
-      if (std::abs(s.x.t - fit_end.t) <= kSameTime) {
-        const StateEstimate a = Carried(s, fit_start, fit_end);
-        for (const Epoch& e : *epochs) {
-          StateEstimate r = a;
-          r.x.t = e.t;
-          r.x.v_w.setZero();
-          r.sigma_v = e.sigma_v;
-          out(r);
-        }
-        if (bridge) EmitBridge(a, &s, *steps, TermsAt(earth, a.x.p_wb), noise, false, out);
+      if (std::abs(s.x.t - t_first) <= kSameTime) {
+        span->start = s;
+        span->P = CovarianceOf(s, P0);
+        for (const StateEstimate& b : filler(*span)) out(b);
       }
     }
     out(s);

@@ -49,13 +49,14 @@ Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, Stat
   attachers_.push_back(std::make_unique<GnssAttacher>(
       options_.gnss, [this](double t, bool accepted) { WatchGnss(t, accepted); },
       [this](double factor) { RelievePrior(factor); }));
+  pre_init_.SetBackwardFiller([this](const BackwardSpan& span) { return FillBackward(options_, span); });
 }
 
 Smoother::~Smoother() = default;
 
 NavState Smoother::NewestState() const { return window_.back().State(); }
 
-void Smoother::AddRestState(const StateEstimate& s) { pre_init_.Add(s, on_batch_ != nullptr, on_final_, on_online_); }
+void Smoother::AddRestState(const StateEstimate& s) { pre_init_.Add(s, on_final_, on_online_); }
 
 void Smoother::Initialize(const InitResult& init) {
   pre_init_.Start(init, on_final_);  // the online stream is for the newest state: not the late window

@@ -47,5 +47,16 @@ TEST(EarthModelTest, GravityFollowsTheLocalVertical) {
   EXPECT_NEAR(e.Gravity(Vec3(0, 0, 100)).norm() - e.Gravity(Vec3::Zero()).norm(), -3.1e-4, 1e-5);
 }
 
+// The same Earth backwards: its rotation negated, its gravity as it was.
+TEST(EarthModelTimeReversed, NegatesTheRotationAlone) {
+  const EarthModel e = EarthModel::Rotating(LocalEnuFrame({40.0, -105.0, 1600.0}));
+  const EarthModel r = e.TimeReversed();
+  EXPECT_EQ(r.rate_w(), -e.rate_w());
+  EXPECT_GT(e.rate_w().norm(), 7e-5);
+  const Vec3 p(1200.0, -300.0, 15.0);
+  EXPECT_EQ(r.Gravity(p), e.Gravity(p));
+  EXPECT_EQ(r.g_norm(), e.g_norm());
+}
+
 }  // namespace
 }  // namespace gins

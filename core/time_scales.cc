@@ -30,29 +30,28 @@ constexpr double kLeapDays[] = {
 };
 constexpr int kLeaps = sizeof(kLeapDays) / sizeof(kLeapDays[0]);
 
-// Days since 1970-01-01 of a civil date, and back (H. Hinnant's algorithms, exact for any year).
-long DaysFromCivil(int y, int m, int d) {
+}  // namespace
+
+int64_t DaysFromCivil(int y, int m, int d) {
   y -= m <= 2;
-  const long era = (y >= 0 ? y : y - 399) / 400;
-  const long yoe = y - era * 400;
-  const long doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
-  const long doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  const int64_t era = (y >= 0 ? y : y - 399) / 400;
+  const int64_t yoe = y - era * 400;
+  const int64_t doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const int64_t doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
   return era * 146097 + doe - 719468;
 }
 
-void CivilFromDays(long z, int* y, int* m, int* d) {
+void CivilFromDays(int64_t z, int* y, int* m, int* d) {
   z += 719468;
-  const long era = (z >= 0 ? z : z - 146096) / 146097;
-  const long doe = z - era * 146097;
-  const long yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
-  const long doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-  const long mp = (5 * doy + 2) / 153;
+  const int64_t era = (z >= 0 ? z : z - 146096) / 146097;
+  const int64_t doe = z - era * 146097;
+  const int64_t yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+  const int64_t doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+  const int64_t mp = (5 * doy + 2) / 153;
   *d = static_cast<int>(doy - (153 * mp + 2) / 5 + 1);
   *m = static_cast<int>(mp < 10 ? mp + 3 : mp - 9);
   *y = static_cast<int>(yoe + era * 400 + (*m <= 2));
 }
-
-}  // namespace
 
 bool ParseLogTimeScale(const std::string& name, LogTimeScale* scale) {
   if (name == "gps") {
@@ -98,7 +97,7 @@ UtcCalendar ToUtcCalendar(double unix_utc) {
   const double days = std::floor(unix_utc / 86400.0);
   double sod = unix_utc - days * 86400.0;
   UtcCalendar c;
-  CivilFromDays(static_cast<long>(days), &c.year, &c.month, &c.day);
+  CivilFromDays(static_cast<int64_t>(days), &c.year, &c.month, &c.day);
   c.hour = static_cast<int>(sod / 3600.0);
   sod -= c.hour * 3600.0;
   c.minute = static_cast<int>(sod / 60.0);

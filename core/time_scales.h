@@ -3,6 +3,8 @@
 // (docs/formats.md §2.6).
 #pragma once
 
+#include <cstdint>
+
 #include <string>
 
 namespace gins {
@@ -31,6 +33,10 @@ double UnixUtcToGps(double unix_utc);
 double LogTimeToUnixUtc(double t, LogTimeScale scale);
 double UnixUtcToLogTime(double unix_utc, LogTimeScale scale);
 
+// Days since 1970-01-01 of a proleptic Gregorian date, and back (H. Hinnant's algorithms, exact for any
+// year).
+int64_t DaysFromCivil(int year, int month, int day);
+void CivilFromDays(int64_t days, int* year, int* month, int* day);
 // A Unix UTC time as a calendar date and time of day (proleptic Gregorian); times beyond ±1e15 s (30 million
 // years) are taken at that bound.
 struct UtcCalendar {

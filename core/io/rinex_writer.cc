@@ -8,25 +8,14 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/time_scales.h"
+
 namespace gins {
 
 namespace {
 
 constexpr int64_t kTicksPerSecond = 10000000;  // the epoch line's 1e-7 s
 constexpr int64_t kGpsEpochUnixDays = 3657;    // 1980-01-06 in days since 1970-01-01
-
-// Howard Hinnant's civil_from_days (proleptic Gregorian), days since 1970-01-01.
-void CivilFromDays(int64_t z, int* year, int* month, int* day) {
-  z += 719468;
-  const int64_t era = (z >= 0 ? z : z - 146096) / 146097;
-  const int64_t doe = z - era * 146097;
-  const int64_t yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
-  const int64_t doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-  const int64_t mp = (5 * doy + 2) / 153;
-  *day = static_cast<int>(doy - (153 * mp + 2) / 5 + 1);
-  *month = static_cast<int>(mp < 10 ? mp + 3 : mp - 9);
-  *year = static_cast<int>(yoe + era * 400 + (*month <= 2 ? 1 : 0));
-}
 
 // Whole seconds and 1e-7 s ticks of GPS seconds, rounded once (the fraction of a double near 1.4e9 is exact).
 void SplitTicks(double gps_s, int64_t* whole, int64_t* ticks) {

@@ -1,9 +1,9 @@
-// The two-sided outputs before what the initialisation's fit covers (docs/estimators.md, "Initialisation"):
-// a vehicle that stood, moved and stood again before the fit's window (or a log that starts while moving)
-// has fixes and IMU samples there that no forward estimator could use, having no attitude yet. Once the
-// two-sided pass knows the state at the fit's start, the same ESKF runs backwards in time from it through
-// those samples, fixes and standstills, and its own RTS pass smooths the result: each epoch then has every
-// measurement on both sides of it.
+// The outputs before the initialisation (solver/pre_init_output.h, docs/estimators.md "Initialisation"): a
+// vehicle that stood, moved and stood again before the fit's window (or a log that starts while moving) has
+// fixes and IMU samples there that no forward estimator could use, having no attitude yet. Once a state is
+// known (the fit's first state for the forward streams, the first two-sided state for the others), the same
+// ESKF runs backwards in time from it through those samples, fixes and standstills, and its own RTS pass
+// smooths the result: each epoch then has every measurement of the span on both sides of it.
 //
 // Time reversal (t' = 2·t_s − t): the mechanisation is the same with the gyro, the velocity, the gyro bias
 // and the Earth's rotation negated (EarthModel::TimeReversed); specific force, gravity, positions and

@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -697,6 +698,94 @@ TEST_F(CliRun, HeadingInRadiansIsRefusedAndNamed) {
   EXPECT_NE(err.find("gins: error: " + log + ": "), std::string::npos) << err;
   EXPECT_NE(err.find("headings are in radians, not degrees"), std::string::npos) << err;
   EXPECT_EQ(FilesIn(out), 0u);
+}
+
+// A drive of stops, starts and turns in both directions, west enough that its latitude and longitude are
+// both below 90° (a swap stays a valid position).
+constexpr const char* kStopAndGoConfig = R"(# cli_test, mistakes
+simulate:
+  seed: 43
+  start_time_s: 1700000000
+  origin: [31.5, 60.4, 10.0]
+  initial_heading_deg: 30
+  segments:
+    - {duration_s: 10}
+    - {duration_s: 8, accel_m_s2: 1.0}
+    - {duration_s: 10, yaw_rate_deg_s: 6}
+    - {duration_s: 6, accel_m_s2: -1.3}
+    - {duration_s: 5}
+    - {duration_s: 6, accel_m_s2: 1.5}
+    - {duration_s: 10, yaw_rate_deg_s: -8}
+    - {duration_s: 8, accel_m_s2: -1.0}
+    - {duration_s: 6, accel_m_s2: 1.2}
+    - {duration_s: 10, yaw_rate_deg_s: 5}
+    - {duration_s: 6, accel_m_s2: -1.2}
+    - {duration_s: 5}
+    - {duration_s: 6, accel_m_s2: 1.0}
+    - {duration_s: 10}
+  imu_rate_hz: 100
+  gnss_rate_hz: 1
+  wheel_rate_hz: 10
+)";
+
+// Two more first-log mistakes (core/imu_checks.h TurnRateCheck, core/clock_checks.h ClockOffsetCheck) through
+// gins run: latitude and longitude swapped, and the GNSS records 18 s after or before the IMU's (GPS time
+// against UTC). Each exits 1 naming the log, the cause and the fix, and writes nothing; the log as simulated
+// runs.
+TEST(CliMistakes, SwappedLatitudeLongitudeAndLeapSecondsAreRefusedAndNamed) {
+  const std::string dir = test::MakeTempDir("cli_mistakes");
+  const std::string config = dir + "/config.yaml";
+  test::WriteFile(config, kStopAndGoConfig);
+  ASSERT_EQ(RunCliInChild({"simulate", "--config", config, "--out", dir + "/sim"}), 0);
+  const std::string text = test::ReadFile(dir + "/sim/log.txt");
+  // The GNSS records moved by `shift` seconds and the log written in time order again, as a logger would.
+  const auto shifted = [&](double shift) {
+    std::vector<std::pair<double, std::string>> lines;
+    for (std::string line : Lines(text)) {
+      if (line.rfind("#", 0) == 0) continue;
+      const size_t start = line.find(' ') + 1, end = line.find(' ', start);
+      double t = std::stod(line.substr(start, end - start));
+      if (line.rfind("GNSS ", 0) == 0) {
+        t += shift;
+        line = "GNSS " + Fixed(t, 6) + line.substr(end);
+      }
+      lines.emplace_back(t, line);
+    }
+    std::stable_sort(lines.begin(), lines.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::string out;
+    for (const auto& l : lines) out += l.second + "\n";
+    return out;
+  };
+  const std::string swapped = EditGnssFields(text, [](std::vector<std::string>* f) { std::swap((*f)[2], (*f)[3]); });
+  const struct {
+    const char* name;
+    std::string text;
+    const char* cause;
+  } cases[] = {
+      {"swapped", swapped, "latitude and longitude swapped in the GNSS records"},
+      {"gnss_18s_late", shifted(18.0), "stamped 18 s after the IMU's"},
+      {"gnss_18s_early", shifted(-18.0), "stamped 18 s before the IMU's"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string log = dir + "/" + c.name + ".txt", out = dir + "/out_" + c.name;
+    test::WriteFile(log, c.text);
+    std::string err;
+    EXPECT_EQ(RunCliCapturingStderr({"run", "--config", config, "--log", log, "--out", out, "--mode", "both"},
+                                    out + ".err", &err),
+              1);
+    EXPECT_NE(err.find("gins: error: " + log + ": "), std::string::npos) << err;
+    EXPECT_NE(err.find(c.cause), std::string::npos) << err;
+    if (c.name != std::string("swapped")) {
+      EXPECT_NE(err.find("gnss.time_offset_s: " + std::string(c.name == std::string("gnss_18s_late") ? "18" : "-18")),
+                std::string::npos)
+          << err;
+    }
+    EXPECT_EQ(FilesIn(out), 0u);
+  }
+  EXPECT_EQ(RunCliInChild({"run", "--config", config, "--log", dir + "/sim/log.txt", "--out", dir + "/out_clean",
+                           "--mode", "both"}),
+            0);
 }
 
 TEST_F(CliRun, LogThatNeverInitialisesWritesNothing) {

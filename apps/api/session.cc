@@ -1,6 +1,7 @@
 // api::Session (gins/gins.h): checks each pushed measurement as the log reader checks a line, sorts it in
 // through the reorder buffer, and feeds the internal session (solver/estimator_pipeline.h) that owns the estimators;
 // their states come back through Emit, converted to the public State.
+#include <atomic>
 #include <cmath>
 #include <deque>
 #include <exception>
@@ -55,6 +56,8 @@ class Session::Impl {
   StateCallback callback_;
   std::deque<State> queue_;
   std::exception_ptr callback_error_;  // the first exception of the current call, rethrown at its end
+  // Set with callback_error_: Push checks it per record without taking the lock.
+  std::atomic<bool> has_callback_error_{false};
   bool finished_ = false;
   InputIssue issue_;                                                  // reused: a valid record allocates nothing
   std::map<std::pair<std::string, std::string>, uint64_t> rejected_;  // (measurement, reason) -> count
@@ -167,11 +170,14 @@ void Session::Impl::Emit(Stream stream, const StateEstimate& e) {
   } catch (...) {
     ++callback_errors_;
     if (!callback_error_) callback_error_ = std::current_exception();
+    has_callback_error_.store(true, std::memory_order_release);
   }
 }
 
 void Session::Impl::RethrowCallbackError() {
+  if (!has_callback_error_.load(std::memory_order_acquire)) return;
   const std::lock_guard<std::mutex> lock(emit_mutex_);
+  has_callback_error_.store(false, std::memory_order_relaxed);
   if (callback_error_) std::rethrow_exception(std::exchange(callback_error_, nullptr));
 }
 

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/io/background_write.h"
 #include "core/io/number_format.h"
 
 namespace gins {
@@ -80,14 +81,14 @@ AtomicFile::AtomicFile(const std::string& path)
     : path_(path), tmp_path_(path + ".tmp." + std::to_string(::getpid())) {
   {
     const std::lock_guard<std::recursive_mutex> lock(UncommittedLock());
-    file_ = std::fopen(tmp_path_.c_str(), "wb");
+    // Large buffer: trajectory files are written line by line at IMU rate. It must be ours: glibc ignores
+    // the size when setvbuf allocates (it wrote 4 KiB at a time, one system call per ~15 lines). Its
+    // write(2) calls run on a thread of their own (core/io/background_write.h).
+    buffer_ = std::make_unique<char[]>(kBufferSize);
+    file_ = OpenBackgroundWriteStream(tmp_path_, buffer_.get(), kBufferSize);
     if (file_ == nullptr) throw std::runtime_error(path_ + ": cannot create: " + std::strerror(errno));
     Uncommitted().insert(tmp_path_);
   }
-  // Large buffer: trajectory files are written line by line at IMU rate. It must be ours: glibc ignores
-  // the size when setvbuf allocates (it wrote 4 KiB at a time, one system call per ~15 lines).
-  buffer_ = std::make_unique<char[]>(kBufferSize);
-  std::setvbuf(file_, buffer_.get(), _IOFBF, kBufferSize);
 }
 
 AtomicFile::~AtomicFile() {

@@ -133,7 +133,7 @@ TEST(AtomicFile, AbandonRemovesOnlyTheUncommittedAndWaitsForACommitGroup) {
   EXPECT_EQ(test::ReadFile(dir + "/b.txt"), "/b.txt");
 }
 
-// Contents larger than the stream's own buffer (1 MiB) arrive whole and in order.
+// Contents larger than the stream's own buffer (256 KiB) arrive whole and in order.
 TEST(AtomicFile, LargeContentsArriveWhole) {
   const std::string dir = test::MakeTempDir("atomic_large");
   const std::string path = dir + "/out.txt";

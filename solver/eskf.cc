@@ -359,16 +359,16 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
   if (rts_) rts_->AfterUpdates(Nominal(), P_);  // the chain before the re-initialisation ends here
   const bool finite = nom_.x.AllFinite() && P_.allFinite();
   if (!finite) {
-    nom_.x.q_wb = FallbackAttitude(m, options_);
+    nom_.x.q_wb = FallbackAttitude(m, options_.gnss);
     nom_.x.bg.setZero();
     nom_.x.ba.setZero();
     nom_.x.v_w.setZero();
     nom_.ResetNonFinite();
     P_.setZero();
-    P_.topLeftCorner<nav::kDim, nav::kDim>() = FallbackCovariance(options_);
+    P_.topLeftCorner<nav::kDim, nav::kDim>() = FallbackCovariance(options_.imu);
     SetAdditivePriors();
   }
-  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &nom_.x, P_, course_wait_.Take());
+  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, options_.watchdog, &nom_.x, P_, course_wait_.Take());
   phase_epoch_.valid = false;  // the position jumped: no displacement to difference across
   P_ = 0.5 * (P_ + P_.transpose());
   gyro_sum_.setZero();

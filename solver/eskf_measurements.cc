@@ -44,7 +44,7 @@ void Eskf::AddGnss(const GnssMeasurement& m) {
     FlushCovariance();
     const bool finite = nom_.AllFinite() && P_.allFinite();
     const double sigma_p = std::sqrt(BlockOf<Block::kP>(P_).diagonal().maxCoeff());
-    const FixVerdict verdict = WatchdogVerdict(m, finite, sigma_p, options_, nom_.x, P_, &course_wait_, &prev_fix_);
+    const FixVerdict verdict = WatchdogVerdict(m, finite, sigma_p, options_, options_.watchdog, nom_.x, P_, &course_wait_, &prev_fix_);
     if (verdict != FixVerdict::kUse) {
       if (verdict == FixVerdict::kReset) {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");

@@ -34,8 +34,8 @@ bool YawLost(const Quat& q_wb, const Eigen::Ref<const MatX>& P) {
   return !(YawVariance(q_wb, P) <= kResetLostYawSigma * kResetLostYawSigma);  // NaN too
 }
 
-bool HeadingUsable(const GnssMeasurement& m, const EstimatorOptions& options) {
-  return m.heading_valid && options.gnss.use_heading && std::isfinite(m.yaw_G);
+bool HeadingUsable(const GnssMeasurement& m, const GnssOptions& gnss) {
+  return m.heading_valid && gnss.use_heading && std::isfinite(m.yaw_G);
 }
 
 // The course of the two fixes as the yaw of a car's body x axis, with its 1-σ; none when the fixes are not
@@ -54,26 +54,26 @@ std::optional<std::pair<double, double>> CourseOf(const GnssMeasurement& m,
 }  // namespace
 
 bool ResetWaitsForCourse(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                         const EstimatorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P,
+                         const SensorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P,
                          bool waiting) {
-  if (!options.vehicle.nonholonomic || HeadingUsable(m, options) || CourseOf(m, prev_fix)) return false;
+  if (!options.vehicle.nonholonomic || HeadingUsable(m, options.gnss) || CourseOf(m, prev_fix)) return false;
   if (waiting) return prev_fix && m.t - prev_fix->t < kResetMaxFixInterval;
   return x.q_wb.coeffs().allFinite() && YawLost(x.q_wb, P);
 }
 
 bool CourseWait::Hold(const GnssMeasurement& m, std::optional<GnssMeasurement>* prev_fix,
-                      const EstimatorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P) {
+                      const SensorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P) {
   if (!ResetWaitsForCourse(m, *prev_fix, options, x, P, waiting_)) return false;
   if (!waiting_) *prev_fix = m;
   waiting_ = true;
   return true;
 }
 
-FixVerdict WatchdogVerdict(const GnssMeasurement& m, bool finite, double sigma_p, const EstimatorOptions& options,
-                           const NavState& x, const Eigen::Ref<const MatX>& P, CourseWait* wait,
-                           std::optional<GnssMeasurement>* prev_fix) {
-  if (!options.watchdog.enabled) return FixVerdict::kUse;
-  if (!(wait->waiting() || !finite || sigma_p > options.watchdog.max_position_sigma)) return FixVerdict::kUse;
+FixVerdict WatchdogVerdict(const GnssMeasurement& m, bool finite, double sigma_p, const SensorOptions& options,
+                           const WatchdogOptions& watchdog, const NavState& x, const Eigen::Ref<const MatX>& P,
+                           CourseWait* wait, std::optional<GnssMeasurement>* prev_fix) {
+  if (!watchdog.enabled) return FixVerdict::kUse;
+  if (!(wait->waiting() || !finite || sigma_p > watchdog.max_position_sigma)) return FixVerdict::kUse;
   // A lost yaw waits for a later fix's course rather than being kept (ResetWaitsForCourse).
   return finite && wait->Hold(m, prev_fix, options, x, P) ? FixVerdict::kHeld : FixVerdict::kReset;
 }
@@ -86,13 +86,13 @@ std::string Describe(const FixReset& r) {
 }
 
 FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                              const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P,
-                              bool yaw_lost_before) {
+                              const SensorOptions& options, const WatchdogOptions& watchdog, NavState* x,
+                              Eigen::Ref<MatX> P, bool yaw_lost_before) {
   FixReset result;
   // A lost yaw is replaced before the lever arm is applied: the arm turns with the body.
   const bool yaw_lost = yaw_lost_before || YawLost(x->q_wb, P);
   std::optional<std::pair<double, double>> yaw;  // the new yaw and its 1-σ
-  if (yaw_lost && HeadingUsable(m, options)) {
+  if (yaw_lost && HeadingUsable(m, options.gnss)) {
     yaw = std::make_pair(m.yaw_G - options.gnss.mount_yaw, m.sigma_yaw);
     result.yaw = "heading";
   } else if (yaw_lost && options.vehicle.nonholonomic) {
@@ -106,7 +106,7 @@ FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<Gnss
     const Quat turn = QuatFromYaw(yaw->first - YawOfXAxis<double>(x->q_wb.toRotationMatrix()));
     x->q_wb = (turn * x->q_wb).normalized();
     x->v_w = turn * x->v_w;
-    const Mat3 fallback = FallbackCovariance(options).block<3, 3>(nav::kTheta, nav::kTheta);
+    const Mat3 fallback = FallbackCovariance(options.imu).block<3, 3>(nav::kTheta, nav::kTheta);
     const Mat3 P_att = P.block<3, 3>(nav::kTheta, nav::kTheta);
     const double level_var = std::min(std::max(P_att(0, 0), P_att(1, 1)), fallback(0, 0));
     const Vec3 z_b = x->q_wb.conjugate() * Vec3::UnitZ();
@@ -132,7 +132,7 @@ FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<Gnss
     P.middleCols(k, 3).setZero();
   }
   // Well inside watchdog.max_position_sigma_m, or the next check would reset again.
-  const double cap = 0.25 * options.watchdog.max_position_sigma;
+  const double cap = 0.25 * watchdog.max_position_sigma;
   const double sigma_p = std::min(kResetPosSigma, cap);
   P.block<3, 3>(nav::kP, nav::kP).diagonal() = m.sigma_w.cwiseAbs2() + Vec3::Constant(sigma_p * sigma_p);
   const double sigma_v =
@@ -141,7 +141,7 @@ FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<Gnss
   // A vehicle's attitude is known at least as well as the fallback's (level within 0.22 rad, yaw within
   // 1 rad): a larger attitude σ (a long coast's) is reset to that, decorrelated from the rest, so the next
   // fixes are not read as tilt.
-  const Mat3 fallback = FallbackCovariance(options).block<3, 3>(nav::kTheta, nav::kTheta);
+  const Mat3 fallback = FallbackCovariance(options.imu).block<3, 3>(nav::kTheta, nav::kTheta);
   const Vec3 att_var = P.block<3, 3>(nav::kTheta, nav::kTheta).diagonal();
   if (!(att_var.array() <= fallback.diagonal().array()).all()) {
     const Vec3 capped = att_var.cwiseMin(fallback.diagonal());
@@ -156,15 +156,15 @@ FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<Gnss
   return result;
 }
 
-Quat FallbackAttitude(const GnssMeasurement& m, const EstimatorOptions& options) {
-  return QuatFromYaw(m.heading_valid ? m.yaw_G - options.gnss.mount_yaw : 0.0);
+Quat FallbackAttitude(const GnssMeasurement& m, const GnssOptions& gnss) {
+  return QuatFromYaw(m.heading_valid ? m.yaw_G - gnss.mount_yaw : 0.0);
 }
 
-Mat15 FallbackCovariance(const EstimatorOptions& options) {
+Mat15 FallbackCovariance(const ImuOptions& imu) {
   Mat15 P = Mat15::Zero();
   P.block<3, 3>(nav::kTheta, nav::kTheta).diagonal() << 0.05, 0.05, 1.0;
-  P.block<3, 3>(nav::kBg, nav::kBg).diagonal().setConstant(std::pow(options.imu.init_gyro_bias_sigma, 2));
-  P.block<3, 3>(nav::kBa, nav::kBa).diagonal().setConstant(std::pow(options.imu.init_acc_bias_sigma, 2));
+  P.block<3, 3>(nav::kBg, nav::kBg).diagonal().setConstant(std::pow(imu.init_gyro_bias_sigma, 2));
+  P.block<3, 3>(nav::kBa, nav::kBa).diagonal().setConstant(std::pow(imu.init_acc_bias_sigma, 2));
   return P;
 }
 

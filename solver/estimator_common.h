@@ -139,8 +139,8 @@ inline bool AcceleratingWithoutWitness(const StandstillMeasurement& m, const Nav
 // heading if the fix has one) and zero biases, with this covariance in NavState tangent order: attitude
 // 1-σ 0.22 rad in roll and pitch and 1 rad in yaw, biases at their initial σ (imu.init_*_bias_sigma);
 // position and velocity come from the fix (ResetPositionFromFix).
-Quat FallbackAttitude(const GnssMeasurement& m, const EstimatorOptions& options);
-Mat15 FallbackCovariance(const EstimatorOptions& options);
+Quat FallbackAttitude(const GnssMeasurement& m, const GnssOptions& gnss);
+Mat15 FallbackCovariance(const ImuOptions& imu);
 
 // summary.json's "time_offset" of an estimator: whether it is estimated, the stated gnss.time_offset_s plus
 // the estimated part td (s), and td's 1-σ (0 when held).
@@ -162,14 +162,15 @@ struct FixReset {
 // `yaw_lost`: the estimator found the yaw lost at an earlier fix and waited for this one
 // (ResetWaitsForCourse); the updates in between may have shrunk its variance, not made it right.
 FixReset ResetPositionFromFix(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                              const EstimatorOptions& options, NavState* x, Eigen::Ref<MatX> P,
+                              const SensorOptions& options, const WatchdogOptions& watchdog, NavState* x,
+                              Eigen::Ref<MatX> P,
                               bool yaw_lost = false);
 // A reset at m would keep a lost yaw that a later fix can give (ResetPositionFromFix): the estimator holds
 // m and waits instead, for the first fix whose course from m is within about 20° (a second on a 1 Hz RTK
 // receiver; a few fixes at 5-20 Hz with metre-level noise), at most 2 s; then it resets with yaw_lost set.
 // `waiting`: prev_fix is the fix held (the call decides whether to wait on). P as above, at m's time.
 bool ResetWaitsForCourse(const GnssMeasurement& m, const std::optional<GnssMeasurement>& prev_fix,
-                         const EstimatorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P,
+                         const SensorOptions& options, const NavState& x, const Eigen::Ref<const MatX>& P,
                          bool waiting = false);
 // The log line's words for a reset.
 std::string Describe(const FixReset& r);
@@ -180,7 +181,7 @@ std::string Describe(const FixReset& r);
 class CourseWait {
  public:
   bool waiting() const { return waiting_; }
-  bool Hold(const GnssMeasurement& m, std::optional<GnssMeasurement>* prev_fix, const EstimatorOptions& options,
+  bool Hold(const GnssMeasurement& m, std::optional<GnssMeasurement>* prev_fix, const SensorOptions& options,
             const NavState& x, const Eigen::Ref<const MatX>& P);
   bool Take() {
     const bool waited = waiting_;
@@ -197,8 +198,8 @@ class CourseWait {
 // lost while a reset waits for a course (CourseWait). kUse: the fix is used as usual; kHeld: the reset waits,
 // m held for its course; kReset: the estimator re-initialises from m. Always kUse with the watchdog off.
 enum class FixVerdict { kUse, kHeld, kReset };
-FixVerdict WatchdogVerdict(const GnssMeasurement& m, bool finite, double sigma_p, const EstimatorOptions& options,
-                           const NavState& x, const Eigen::Ref<const MatX>& P, CourseWait* wait,
+FixVerdict WatchdogVerdict(const GnssMeasurement& m, bool finite, double sigma_p, const SensorOptions& options,
+                           const WatchdogOptions& watchdog, const NavState& x, const Eigen::Ref<const MatX>& P, CourseWait* wait,
                            std::optional<GnssMeasurement>* prev_fix);
 
 }  // namespace gins

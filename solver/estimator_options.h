@@ -57,6 +57,6 @@ struct EstimatorOptions : InitializerOptions {
 
 // The odometer scale is a state (the ESKF's δs, the keyframes' scale block) only with wheels and
 // wheel.estimate_scale.
-inline bool OdometerScaleEstimated(const EstimatorOptions& o) { return o.wheel.enabled && o.wheel.estimate_scale; }
+inline bool OdometerScaleEstimated(const SensorOptions& o) { return o.wheel.enabled && o.wheel.estimate_scale; }
 
 }  // namespace gins

@@ -39,22 +39,22 @@ void BiasFromNav(const NavState& x, double* values) {
   bg = x.bg;
   ba = x.ba;
 }
-double ScalePriorSigma(const EstimatorOptions& options) { return options.wheel.scale_sigma; }
-ceres::CostFunction* BiasRandomWalk(const EstimatorOptions& options, double dt) {
+double ScalePriorSigma(const SensorOptions& options) { return options.wheel.scale_sigma; }
+ceres::CostFunction* BiasRandomWalk(const SensorOptions& options, double dt) {
   return BiasRwFactor::Create(options.imu.gyro_bias_rw, options.imu.acc_bias_rw, dt);
 }
-ceres::CostFunction* ScaleRandomWalk(const EstimatorOptions& options, double dt) {
+ceres::CostFunction* ScaleRandomWalk(const SensorOptions& options, double dt) {
   return ScaleRwFactor::Create(options.wheel.scale_rw, dt);
 }
-double ScaleRandomWalkSigma(const EstimatorOptions& options) { return options.wheel.scale_rw; }
-bool TimeOffsetEstimated(const EstimatorOptions& options) { return options.gnss.estimate_time_offset; }
-double TimeOffsetPriorSigma(const EstimatorOptions& options) { return options.gnss.time_offset_sigma; }
+double ScaleRandomWalkSigma(const SensorOptions& options) { return options.wheel.scale_rw; }
+bool TimeOffsetEstimated(const SensorOptions& options) { return options.gnss.estimate_time_offset; }
+double TimeOffsetPriorSigma(const SensorOptions& options) { return options.gnss.time_offset_sigma; }
 // A random walk of 0 (allowed: a constant offset) would make the factor's weight infinite; this floor keeps
 // the offset constant to 0.1 ms over an hour.
-double TimeOffsetRandomWalkSigma(const EstimatorOptions& options) {
+double TimeOffsetRandomWalkSigma(const SensorOptions& options) {
   return std::max(options.gnss.time_offset_rw, kMinTimeOffsetRandomWalk);
 }
-ceres::CostFunction* TimeOffsetRandomWalk(const EstimatorOptions& options, double dt) {
+ceres::CostFunction* TimeOffsetRandomWalk(const SensorOptions& options, double dt) {
   return ScaleRwFactor::Create(TimeOffsetRandomWalkSigma(options), dt);  // a scalar random walk, as the scale's
 }
 
@@ -150,7 +150,7 @@ ceres::Solver::Options ChainSolverOptions(std::shared_ptr<ceres::ParameterBlockO
   return so;
 }
 
-KeyframeStore::KeyframeStore(const EstimatorOptions& options) : options_(options) {
+KeyframeStore::KeyframeStore(const SensorOptions& options) : options_(options) {
   for (const BlockSpec& spec : kBlockSpecs) {
     estimated_[static_cast<int>(spec.type)] = spec.estimated == nullptr || spec.estimated(options);
   }

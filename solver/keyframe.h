@@ -51,16 +51,16 @@ struct BlockSpec {
   void (*from_nav)(const NavState& x, double* values);
   // Whether the options estimate the block; one that is not is held constant in the problem and left out
   // of priors, orderings and covariances. Null: always estimated.
-  bool (*estimated)(const EstimatorOptions& options);
+  bool (*estimated)(const SensorOptions& options);
   // For a block outside NavState: its value on a first keyframe (later keyframes start from the previous
   // keyframe's, a random walk's mean) and its 1-σ in the initial prior.
   double initial_value;
-  double (*prior_sigma)(const EstimatorOptions& options);
+  double (*prior_sigma)(const SensorOptions& options);
   // The factor between this block of two consecutive keyframes dt apart, when it is a random walk; null
   // for a block the IMU factor links (pose, velocity).
-  ceres::CostFunction* (*random_walk)(const EstimatorOptions& options, double dt);
+  ceres::CostFunction* (*random_walk)(const SensorOptions& options, double dt);
   // For a random walk outside NavState: its 1-σ per √s, for the window's predicted covariance.
-  double (*random_walk_sigma)(const EstimatorOptions& options);
+  double (*random_walk_sigma)(const SensorOptions& options);
 };
 
 namespace keyframe_blocks {
@@ -70,15 +70,15 @@ void VelocityToNav(const double* values, NavState* x);
 void VelocityFromNav(const NavState& x, double* values);
 void BiasToNav(const double* values, NavState* x);
 void BiasFromNav(const NavState& x, double* values);
-double ScalePriorSigma(const EstimatorOptions& options);
-double ScaleRandomWalkSigma(const EstimatorOptions& options);
-ceres::CostFunction* BiasRandomWalk(const EstimatorOptions& options, double dt);
-ceres::CostFunction* ScaleRandomWalk(const EstimatorOptions& options, double dt);
+double ScalePriorSigma(const SensorOptions& options);
+double ScaleRandomWalkSigma(const SensorOptions& options);
+ceres::CostFunction* BiasRandomWalk(const SensorOptions& options, double dt);
+ceres::CostFunction* ScaleRandomWalk(const SensorOptions& options, double dt);
 // The GNSS time offset beyond gnss.time_offset_s (s; factors/delayed_factor.h), with `estimate` only.
-bool TimeOffsetEstimated(const EstimatorOptions& options);
-double TimeOffsetPriorSigma(const EstimatorOptions& options);
-double TimeOffsetRandomWalkSigma(const EstimatorOptions& options);
-ceres::CostFunction* TimeOffsetRandomWalk(const EstimatorOptions& options, double dt);
+bool TimeOffsetEstimated(const SensorOptions& options);
+double TimeOffsetPriorSigma(const SensorOptions& options);
+double TimeOffsetRandomWalkSigma(const SensorOptions& options);
+ceres::CostFunction* TimeOffsetRandomWalk(const SensorOptions& options, double dt);
 }  // namespace keyframe_blocks
 
 // clang-format off
@@ -181,7 +181,7 @@ std::shared_ptr<Preintegration> ReintegratedIfMoved(const Keyframe& prev, const 
 // The window's keyframes, oldest first, and their blocks in a Ceres problem.
 class KeyframeStore {
  public:
-  explicit KeyframeStore(const EstimatorOptions& options);
+  explicit KeyframeStore(const SensorOptions& options);
 
   // Empties the window; the blocks of the keyframes pushed from now on go to `problem` (not owned).
   void Reset(ceres::Problem* problem);
@@ -249,7 +249,7 @@ class KeyframeStore {
  private:
   ceres::Manifold* ManifoldOf(const BlockSpec& spec);
 
-  EstimatorOptions options_;
+  SensorOptions options_;  // its blocks read imu.*, wheel.* and gnss.* only
   std::array<bool, kNumBlockTypes> estimated_{};
   ceres::Problem* problem_ = nullptr;
   PoseManifold pose_manifold_;

@@ -15,7 +15,7 @@ struct Layout {
   int n = 0;
 };
 
-Layout LayoutOf(const std::vector<BlockType>& types, const EstimatorOptions& options) {
+Layout LayoutOf(const std::vector<BlockType>& types, const SensorOptions& options) {
   Layout l;
   l.nav_of = NavIndexOfTangent(types);
   l.n = static_cast<int>(l.nav_of.size());
@@ -34,7 +34,7 @@ Layout LayoutOf(const std::vector<BlockType>& types, const EstimatorOptions& opt
 }  // namespace
 
 MatX PredictBlockCovariance(const std::vector<BlockType>& types, const MatX& cov_i, const NavState& x_i,
-                            const Preintegration& pre, const EstimatorOptions& options, MatX* joint) {
+                            const Preintegration& pre, const SensorOptions& options, MatX* joint) {
   const Layout l = LayoutOf(types, options);
   // Φ and Q in block order: NavState's through the preintegration, the other blocks random walks.
   Mat15 Phi15, Q15;

@@ -21,7 +21,7 @@ namespace gins {
 // cov_i): the preintegrated transition, the IMU noise over it and the random walks of biases, scale and time offset.
 // joint (optional): the covariance of both, i's blocks then the predicted ones.
 MatX PredictBlockCovariance(const std::vector<BlockType>& types, const MatX& cov_i, const NavState& x_i,
-                            const Preintegration& pre, const EstimatorOptions& options, MatX* joint = nullptr);
+                            const Preintegration& pre, const SensorOptions& options, MatX* joint = nullptr);
 
 // The covariance restricted to some of a keyframe's blocks (their tangents, in the order listed).
 MatX SubCovariance(const std::vector<BlockType>& types, const MatX& cov, const std::vector<BlockType>& wanted,

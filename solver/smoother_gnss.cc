@@ -29,7 +29,7 @@ void Smoother::AddGnss(const GnssMeasurement& m) {
     const double sigma_p = std::sqrt(P.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
     const bool finite = window_.back().State().AllFinite() && pred_.AllFinite() && std::isfinite(sigma_p);
     const FixVerdict verdict =
-        WatchdogVerdict(m, finite, std::max(sigma_p, last_sigma_p_), options_, p.x, P, &course_wait_, &prev_fix_);
+        WatchdogVerdict(m, finite, std::max(sigma_p, last_sigma_p_), options_, options_.watchdog, p.x, P, &course_wait_, &prev_fix_);
     if (verdict != FixVerdict::kUse) {
       if (verdict == FixVerdict::kReset) {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
@@ -82,13 +82,13 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
     init.x0 = at_fix.AllFinite() ? at_fix : window_.front().State();
     window_.KeepValues(window_.front());
   } else {
-    init.x0.q_wb = FallbackAttitude(m, options_);
+    init.x0.q_wb = FallbackAttitude(m, options_.gnss);
     window_.ForgetValues();
   }
-  if (!have_cov) cov = FallbackCovariance(options_);
+  if (!have_cov) cov = FallbackCovariance(options_.imu);
   init.g_norm = earth_.g_norm();
   init.earth = earth_;
-  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, &init.x0, cov, course_wait_.Take());
+  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, options_.watchdog, &init.x0, cov, course_wait_.Take());
   // Tiny floors keep the prior invertible whatever the window's covariance was.
   cov = 0.5 * (cov + cov.transpose());
   cov.diagonal() = cov.diagonal().cwiseMax(1e-12);

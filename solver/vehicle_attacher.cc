@@ -43,7 +43,7 @@ MatX PairCovariance(const std::vector<BlockType>& types, const MatX& joint, bool
 
 }  // namespace
 
-VehicleAttacher::VehicleAttacher(const EstimatorOptions& options)
+VehicleAttacher::VehicleAttacher(const SensorOptions& options)
     : options_(options),
       gate_nhc_(Chi2Gate(options.wheel.gate_probability, 2)),
       gate_wheel_(Chi2Gate(options.wheel.gate_probability, 1)),

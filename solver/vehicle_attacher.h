@@ -23,7 +23,7 @@ namespace gins {
 
 class VehicleAttacher final : public MeasurementAttacher {
  public:
-  explicit VehicleAttacher(const EstimatorOptions& options);
+  explicit VehicleAttacher(const SensorOptions& options);  // wheel.*, vehicle.*; imu.* for the chord's gate
 
   void OnWheel(const WheelMeasurement& m, const AttachContext& ctx) override;
   void OnImuStep(const ImuStepView& step) override;
@@ -48,7 +48,7 @@ class VehicleAttacher final : public MeasurementAttacher {
   // The odometer and wheel-yaw factors of the closed interval between the two keyframes before kf.
   void AttachOdometry(const AttachContext& ctx);
 
-  EstimatorOptions options_;
+  SensorOptions options_;
   double gate_nhc_, gate_wheel_, gate_yaw_;
   std::optional<Accumulator> open_;     // from the newest keyframe to now
   std::optional<Accumulator> closing_;  // the interval before it, until the record that straddles its end

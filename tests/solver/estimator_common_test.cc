@@ -62,7 +62,7 @@ TEST_F(FixResetTest, LostYawComesFromTheDualAntennaHeading) {
   fix_.heading_valid = true;
   fix_.yaw_G = 1.0 + options_.gnss.mount_yaw;
   fix_.sigma_yaw = 0.2 * kDegToRad;
-  const FixReset r = ResetPositionFromFix(fix_, std::nullopt, options_, &x_, P_);
+  const FixReset r = ResetPositionFromFix(fix_, std::nullopt, options_, options_.watchdog, &x_, P_);
   EXPECT_STREQ(r.yaw, "heading");
   EXPECT_FALSE(r.velocity_from_fixes);
   EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 1.0, 1e-12);
@@ -75,7 +75,7 @@ TEST_F(FixResetTest, LostYawComesFromTheDualAntennaHeading) {
 
 TEST_F(FixResetTest, LostYawOfACarComesFromTheCourseOfTwoFixes) {
   LoseYaw(1.0);
-  const FixReset r = ResetPositionFromFix(fix_, prev_, options_, &x_, P_);
+  const FixReset r = ResetPositionFromFix(fix_, prev_, options_, options_.watchdog, &x_, P_);
   EXPECT_STREQ(r.yaw, "course");
   EXPECT_TRUE(r.velocity_from_fixes);
   EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 0.5 * M_PI, 1e-12);
@@ -85,7 +85,7 @@ TEST_F(FixResetTest, LostYawOfACarComesFromTheCourseOfTwoFixes) {
   LoseYaw(1.0);
   x_.q_wb = Quat::Identity();
   prev_.p_w = fix_.p_w - Vec3(0.0, 0.05, 0.0);
-  EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, options_, &x_, P_).yaw, "kept");
+  EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, options_, options_.watchdog, &x_, P_).yaw, "kept");
   EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 0.0, 1e-12);
 }
 
@@ -93,7 +93,7 @@ TEST_F(FixResetTest, AKnownYawIsKept) {
   LoseYaw(10.0 * kDegToRad);  // within 20°: the linearisation holds
   fix_.heading_valid = true;
   fix_.yaw_G = 1.0;
-  const FixReset r = ResetPositionFromFix(fix_, prev_, options_, &x_, P_);
+  const FixReset r = ResetPositionFromFix(fix_, prev_, options_, options_.watchdog, &x_, P_);
   EXPECT_STREQ(r.yaw, "kept");
   EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 0.0, 1e-12);
   EXPECT_NEAR(YawSigma(x_, P_), 10.0 * kDegToRad, 1e-4);  // about world up, the body rolled 0.02 rad
@@ -101,7 +101,7 @@ TEST_F(FixResetTest, AKnownYawIsKept) {
   LoseYaw(1.0);
   options_.vehicle.nonholonomic = false;
   fix_.heading_valid = false;
-  EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, options_, &x_, P_).yaw, "kept");
+  EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, options_, options_.watchdog, &x_, P_).yaw, "kept");
 }
 
 TEST_F(FixResetTest, WaitsForTheCourseOnlyWhenALaterFixCanGiveTheYaw) {

@@ -133,7 +133,7 @@ nlohmann::json BatchSmoother::TimeOffset() const {
   if (estimated_[static_cast<int>(BlockType::kTimeOffset)] && last_block_cov_.size() > 0) {
     sigma = std::sqrt(std::max(SubCovariance(types_, last_block_cov_, {BlockType::kTimeOffset})(0, 0), 0.0));
   }
-  return TimeOffsetJson(options_.gnss, td, sigma);
+  return TimeOffsetJson(sensors_.gnss, td, sigma);
 }
 
 }  // namespace gins

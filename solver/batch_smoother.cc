@@ -37,8 +37,9 @@ nlohmann::json BatchStats::ToJson() const {
           {"revisit_restored", revisit_restored}};
 }
 
-BatchSmoother::BatchSmoother(const EstimatorOptions& options, std::vector<BlockType> estimated_types)
-    : options_(options), types_(std::move(estimated_types)) {
+BatchSmoother::BatchSmoother(const SensorOptions& sensors, const BatchOptions& batch, const SmootherOptions& smoother,
+                             std::vector<BlockType> estimated_types)
+    : sensors_(sensors), batch_(batch), smoother_(smoother), types_(std::move(estimated_types)) {
   for (BlockType t : types_) estimated_[static_cast<int>(t)] = true;
 }
 
@@ -156,8 +157,8 @@ void BatchSmoother::Solve(FactorLog* log, const EarthModel& earth) {
   // solution. The seam goes where this segment knows the position best (smallest marginal position σ): a
   // keyframe amid GNSS fixes, whose estimate the data beyond the segment would not move, never one inside
   // an outage.
-  const int L = std::max(options_.batch.max_segment_keyframes, 4 * w + 4);
-  const int O = std::clamp(options_.batch.segment_overlap_keyframes, 2 * w + 2, L / 2);
+  const int L = std::max(batch_.max_segment_keyframes, 4 * w + 4);
+  const int O = std::clamp(batch_.segment_overlap_keyframes, 2 * w + 2, L / 2);
   struct Segment {
     int first, seam;
     Prior prior;
@@ -199,8 +200,8 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
     }
     if (prior.cost) problem.AddResidualBlock(prior.cost.get(), nullptr, prior.Params());
 
-    const ceres::Solver::Options so = ChainSolverOptions(ordering, options_.batch.max_iterations,
-                                                         options_.batch.function_tolerance, options_.smoother.num_threads);
+    const ceres::Solver::Options so = ChainSolverOptions(ordering, batch_.max_iterations,
+                                                         batch_.function_tolerance, smoother_.num_threads);
     ceres::Solver::Summary summary;
     ceres::Solve(so, &problem, &summary);
     stats_.iterations += static_cast<int>(summary.iterations.size());
@@ -212,11 +213,11 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
     // The IMU factors are linear in the bias about where they were integrated; where the solution moved
     // the bias further than the window allows, integrate again there and solve once more.
     int reintegrated = 0;
-    if (round < options_.batch.max_relinearizations && summary.IsSolutionUsable()) {
+    if (round < batch_.max_relinearizations && summary.IsSolutionUsable()) {
       for (int k = first + 1; k < last; ++k) {
         if (imu_factor_[k] == SIZE_MAX) continue;
         Keyframe& kf = *kfs_[k];
-        auto fresh = ReintegratedIfMoved(*kfs_[k - 1], *kf.preint, options_.smoother.bias_reintegrate_threshold);
+        auto fresh = ReintegratedIfMoved(*kfs_[k - 1], *kf.preint, smoother_.bias_reintegrate_threshold);
         if (!fresh) continue;
         ImuEarthTerms terms;
         terms.g_w = earth.Gravity(0.5 * (kfs_[k - 1]->State().p_wb + kf.State().p_wb));
@@ -241,7 +242,7 @@ int BatchSmoother::SolveSegment(FactorLog* log, const EarthModel& earth, int fir
       stats_.covariance_time_s += Seconds(std::chrono::steady_clock::now() - t1);
       // The window decided on each fix from one side; check them all again on the two-sided solution and
       // its covariance, and solve once more if a decision changed.
-      if (ok && !revisited && options_.batch.revisit_fixes && Revisit(log, first, last, cov)) {
+      if (ok && !revisited && batch_.revisit_fixes && Revisit(log, first, last, cov)) {
         revisited = true;
         continue;
       }
@@ -296,8 +297,8 @@ void BatchSmoother::SolveBeforeSeam(const FactorLog& log, int first, int seam, c
     AddBorrowed(&problem, lf);
   }
   if (prior.cost) problem.AddResidualBlock(prior.cost.get(), nullptr, prior.Params());
-  const ceres::Solver::Options so = ChainSolverOptions(ordering, options_.batch.max_iterations,
-                                                       options_.batch.function_tolerance, options_.smoother.num_threads);
+  const ceres::Solver::Options so = ChainSolverOptions(ordering, batch_.max_iterations,
+                                                       batch_.function_tolerance, smoother_.num_threads);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
   stats_.iterations += static_cast<int>(summary.iterations.size());
@@ -378,7 +379,7 @@ BatchSmoother::Prior BatchSmoother::MarginalPrior(const FactorLog& log, int firs
 }
 
 void BatchSmoother::Emit(const FactorLog& log, const EarthModel& earth, const StateCallback& out) const {
-  const BridgeNoise noise{options_.imu.gyro_noise_density, options_.imu.acc_noise_density};
+  const BridgeNoise noise{sensors_.imu.gyro_noise_density, sensors_.imu.acc_noise_density};
   static const std::vector<HeldImuSample> kNone;
   for (size_t k = 0; k < kfs_.size(); ++k) {
     const Keyframe& kf = *kfs_[k];

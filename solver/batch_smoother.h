@@ -57,7 +57,10 @@ struct BatchStats {
 class BatchSmoother {
  public:
   // types: the estimated blocks (KeyframeStore::EstimatedTypes), in keyframe order.
-  BatchSmoother(const EstimatorOptions& options, std::vector<BlockType> estimated_types);
+  // Its sections: imu.* (the bridges' noise), gnss.* (the time offset), batch.*, smoother.* (threads and the
+  // reintegration threshold).
+  BatchSmoother(const SensorOptions& sensors, const BatchOptions& batch, const SmootherOptions& smoother,
+                std::vector<BlockType> estimated_types);
 
   // Solves the logged problem in place: the keyframes' blocks end at the batch solution. IMU factors whose
   // bias moved are integrated again at the solution (replaced in the log) and the problem solved again.
@@ -98,7 +101,9 @@ class BatchSmoother {
   bool RecoverCovariances(ceres::Problem* problem, const std::vector<FactorSpan>& spans, int first, int last,
                           std::vector<MatX>* cov);
 
-  EstimatorOptions options_;
+  const SensorOptions sensors_;
+  const BatchOptions batch_;
+  const SmootherOptions smoother_;
   std::vector<BlockType> types_;
   bool estimated_[kNumBlockTypes] = {};
   PoseManifold pose_manifold_;

@@ -413,7 +413,7 @@ void Smoother::Finish() {
   window_.Clear();
   initialized_ = false;
   if (on_batch_) {
-    BatchSmoother batch(options_, window_.EstimatedTypes());
+    BatchSmoother batch(options_, options_.batch, options_.smoother, window_.EstimatedTypes());
     batch.Solve(factor_log_.get(), earth_);
     batch.Emit(*factor_log_, earth_, pre_init_.TwoSided(on_batch_));
     batch_stats_ = batch.stats().ToJson();

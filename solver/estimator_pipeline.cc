@@ -109,11 +109,7 @@ void EstimatorPipeline::Dispatch(void (Estimator::*add)(const M&), const M& m) {
     return;
   }
   // In this thread: no task object (a heap allocation per record at IMU rate).
-  for (Timed& te : estimators_) {
-    const auto t0 = std::chrono::steady_clock::now();
-    (te.estimator.get()->*add)(m);
-    te.time += std::chrono::steady_clock::now() - t0;
-  }
+  for (Timed& te : estimators_) te.Call([&](Estimator& e) { (e.*add)(m); });
 }
 
 void EstimatorPipeline::DispatchTask(const std::function<void(Estimator&)>& task) {
@@ -128,10 +124,7 @@ void EstimatorPipeline::DispatchTask(const std::function<void(Estimator&)>& task
       w.Submit(false);
       continue;
     }
-    Timed& te = estimators_[i];
-    const auto t0 = std::chrono::steady_clock::now();
-    task(*te.estimator);
-    te.time += std::chrono::steady_clock::now() - t0;
+    estimators_[i].Call(task);
   }
 }
 

@@ -136,6 +136,12 @@ class EstimatorPipeline {
   struct Timed {
     std::unique_ptr<Estimator> estimator;
     std::chrono::steady_clock::duration time{};
+    template <typename F>
+    void Call(F&& f) {  // f(*estimator), its time counted
+      const auto t0 = std::chrono::steady_clock::now();
+      f(*estimator);
+      time += std::chrono::steady_clock::now() - t0;
+    }
   };
   std::vector<Timed> estimators_;
   // Records before the first fix (no world frame yet) wait here; bounded.

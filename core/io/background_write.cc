@@ -4,50 +4,33 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <condition_variable>
-#include <cstring>
-#include <deque>
-#include <mutex>
-#include <thread>
+#include <system_error>
 #include <vector>
+
+#include "core/io/batch_pipe.h"
 
 namespace gins {
 namespace {
 
-constexpr size_t kMaxQueued = 2;  // chunks waiting for the writer thread
-
-// The stream's cookie: owns the descriptor and the thread (started at the first chunk).
+// The stream's cookie: owns the descriptor and the pipe whose thread writes the chunks to it, in order. One
+// chunk waits while another is written; a failed write drops the rest (BatchPipe) and is reported at Close.
 class BackgroundFd {
  public:
-  explicit BackgroundFd(int fd) : fd_(fd) {}
-  BackgroundFd(const BackgroundFd&) = delete;
-  BackgroundFd& operator=(const BackgroundFd&) = delete;
+  explicit BackgroundFd(int fd)
+      : fd_(fd),
+        pipe_([this](const std::vector<char>& chunk) { WriteAll(chunk); }, /*batch_size=*/1,
+              /*max_batches=*/1) {}
 
-  void Write(const char* data, size_t n) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    if (!thread_.joinable()) thread_ = std::thread([this] { Run(); });
-    space_.wait(lock, [this] { return queue_.size() < kMaxQueued; });
-    if (error_ != 0) return;  // the file is lost; fclose reports it
-    std::vector<char> chunk;
-    if (!free_.empty()) {  // reused: its pages stay resident, no new memory per chunk
-      chunk = std::move(free_.back());
-      free_.pop_back();
-    }
-    chunk.assign(data, data + n);
-    queue_.push_back(std::move(chunk));
-    lock.unlock();
-    ready_.notify_one();
-  }
+  void Write(const char* data, size_t n) { pipe_.Push(std::vector<char>(data, data + n)); }
 
   // Waits for every chunk, stops the thread and closes the descriptor: 0, or -1 with errno the first error.
   int Close() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      closing_ = true;
+    int error = 0;
+    try {
+      pipe_.Close();
+    } catch (const std::system_error& e) {
+      error = e.code().value();
     }
-    ready_.notify_one();
-    if (thread_.joinable()) thread_.join();
-    int error = error_;
     if (::close(fd_) != 0 && error == 0) error = errno;
     if (error == 0) return 0;
     errno = error;
@@ -55,44 +38,22 @@ class BackgroundFd {
   }
 
  private:
-  void Run() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    for (;;) {
-      ready_.wait(lock, [this] { return !queue_.empty() || closing_; });
-      if (queue_.empty()) return;  // closing and drained
-      std::vector<char> chunk = std::move(queue_.front());
-      const bool failed = error_ != 0;
-      lock.unlock();
-      const int error = failed ? 0 : WriteAll(chunk.data(), chunk.size());
-      lock.lock();
-      if (error != 0 && error_ == 0) error_ = error;
-      queue_.pop_front();  // only now: the producer may fill at most kMaxQueued chunks meanwhile
-      free_.push_back(std::move(chunk));
-      space_.notify_one();
-    }
-  }
-
-  int WriteAll(const char* p, size_t n) const {
+  void WriteAll(const std::vector<char>& chunk) const {
+    const char* p = chunk.data();
+    size_t n = chunk.size();
     while (n > 0) {
       const ssize_t w = ::write(fd_, p, n);
       if (w < 0) {
         if (errno == EINTR) continue;
-        return errno;
+        throw std::system_error(errno, std::generic_category());
       }
       p += w;
       n -= static_cast<size_t>(w);
     }
-    return 0;
   }
 
   const int fd_;
-  std::mutex mutex_;
-  std::condition_variable ready_, space_;
-  std::deque<std::vector<char>> queue_;  // the front is being written while it is there
-  std::vector<std::vector<char>> free_;
-  int error_ = 0;  // the first write's errno
-  bool closing_ = false;
-  std::thread thread_;
+  BatchPipe<std::vector<char>> pipe_;  // last: its thread writes to fd_
 };
 
 ssize_t CookieWrite(void* cookie, const char* data, size_t n) {

@@ -5,7 +5,7 @@
 // costs a few hundredths of a second when the kernel's pages are warm, and more than the formatting itself
 // when they are not (measured on a virtual machine whose free memory the host had taken back): on the
 // formatting thread that copy set the ESKF's wall time. Memory is bounded: besides the stream's buffer, at
-// most kMaxQueued copies of it wait.
+// most two copies of it, one being written and one waiting (core/io/batch_pipe.h).
 #pragma once
 
 #include <cstddef>

@@ -27,7 +27,7 @@ class AtomicFile {
   const std::string& path() const { return path_; }
 
  private:
-  static constexpr size_t kBufferSize = 1 << 18;  // and at most two copies waiting to be written
+  static constexpr size_t kBufferSize = 1 << 18;  // and at most two copies in flight (background_write.h)
   std::string path_, tmp_path_;
   std::unique_ptr<char[]> buffer_;  // the stream's; outlives it (the destructor closes the stream first)
   FILE* file_ = nullptr;

@@ -15,16 +15,10 @@
 // run of rejected GNSS fixes that agree with one another inflates the gate and, when a fix is accepted under
 // it, the covariance it updates (GateInflation, solver/estimator_common.h): re-acquisition after an outage by design.
 //
-// Robustness (config standstill.*, watchdog.*, imu.max_gap_s):
-// - Standstill (AddStandstill, from the session's detector): zero-velocity update (σ standstill.velocity_
-//   sigma_m_s) and zero-rate update (the mean gyro reading since the last standstill update observes the gyro
-//   bias); ignored while the estimated speed is above standstill.max_speed_m_s.
-// - IMU gap: a step longer than imu.max_gap_s (from the last IMU sample) is not integrated with the held
-//   sample: the state coasts (constant velocity and attitude) with the covariance of an unknown motion
-//   (kImuGap*, solver/estimator_common.h). Each gap is counted and listed.
-// - Watchdog: decided as in both estimators (GnssWatchdog, WatchdogVerdict: solver/estimator_common.h); the
-//   filter re-initialises from the current fix (ResetPositionFromFix there). A glog WARNING and the summary
-//   (watchdog.resets: time, reason) say so.
+// Standstills, IMU gaps and the watchdog behave as docs/robustness.md ("Field robustness") describes, in
+// both estimators alike (solver/estimator_common.h). Here: the zero-rate update takes the mean gyro reading
+// since the last standstill update (it observes the gyro bias); a standstill is ignored while the estimated
+// speed is above standstill.max_speed_m_s; a reset re-initialises from the current fix (ResetPositionFromFix).
 #pragma once
 
 #include <functional>
@@ -34,6 +28,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "core/imu_kernel.h"
@@ -59,11 +54,9 @@ class Eskf : public Estimator {
   std::string name() const override { return "eskf"; }
   void Initialize(const InitResult& init) override;
   void AddImu(const ImuSample& imu) override;
-  void AddGnss(const GnssMeasurement& gnss) override;
-  void AddGnssVelocity(const GnssVelocityMeasurement& gnss_velocity) override;
-  void AddWheel(const WheelMeasurement& wheel) override;
-  void AddStandstill(const StandstillMeasurement& m) override;
-  void AddRawGnss(const RawGnssMeasurement& m) override;
+  void Add(const Measurement& m) override {
+    std::visit([this](const auto& x) { Use(x); }, m);
+  }
   void AddRestState(const StateEstimate& s) override;
   void Finish() override;
   nlohmann::json Stats() const override;
@@ -100,6 +93,12 @@ class Eskf : public Estimator {
   // the biases', over dt.
   void SetAdditivePriors();
   void AddRandomWalks(double dt);
+  // The measurements, one overload per type of Measurement (eskf_measurements.cc; raw GNSS: eskf_raw_gnss.cc).
+  void Use(const GnssMeasurement& m);
+  void Use(const GnssVelocityMeasurement& m);
+  void Use(const WheelMeasurement& m);
+  void Use(const StandstillMeasurement& m);
+  void Use(const RawGnssMeasurement& m);
   // A measurement model linearised at the filter's current nominal state: its residual r = h(x) − z and
   // full-width Jacobian (from the blocks it touches, eskf::EmbedJacobian).
   template <int M>

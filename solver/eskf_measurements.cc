@@ -37,7 +37,7 @@ ShiftedKinematics<T> ShiftedState(const NavState& x, double td, const Vec3& a_w,
 
 }  // namespace
 
-void Eskf::AddGnss(const GnssMeasurement& m) {
+void Eskf::Use(const GnssMeasurement& m) {
   if (!initialized_ || m.t < nom_.x.t) return;
   Propagate(m.t);
   if (options_.watchdog.enabled) {
@@ -115,7 +115,7 @@ void Eskf::UpdateHeading(const GnssMeasurement& m) {
   Update<1>(model, Eigen::Matrix<double, 1, 1>(m.sigma_yaw * m.sigma_yaw), gate_heading_, &heading_counts_, m.t);
 }
 
-void Eskf::AddGnssVelocity(const GnssVelocityMeasurement& m) {
+void Eskf::Use(const GnssVelocityMeasurement& m) {
   if (!initialized_ || m.t < nom_.x.t) return;
   Propagate(m.t);
   // The antenna's velocity includes the lever arm's turn: the body rate from the last IMU sample.
@@ -140,10 +140,10 @@ void Eskf::AddGnssVelocity(const GnssVelocityMeasurement& m) {
   Update<3>(model, Mat3(m.sigma_w.cwiseAbs2().asDiagonal()), gate_gnss_, &gnss_velocity_counts_, m.t);
 }
 
-void Eskf::AddWheel(const WheelMeasurement& m) {
+void Eskf::Use(const WheelMeasurement& m) {
   if (!initialized_ || m.t < nom_.x.t || !options_.wheel.enabled) return;
   Propagate(m.t);
-  // At zero pulses this is a zero-speed measurement; the standstill updates (AddStandstill) come from the
+  // At zero pulses this is a zero-speed measurement; the standstill updates (StandstillMeasurement) come from the
   // session's detector, which also wants the IMU quiet.
   UpdateWheelSpeed(m);
   if (m.has_yaw_rate) UpdateWheelYawRate(m);
@@ -216,7 +216,7 @@ void Eskf::UpdateNonHolonomic(double t) {
   Update<2>(model, Eigen::Matrix2d::Identity() * s2, gate_nhc_, &nhc_counts_, t);
 }
 
-void Eskf::AddStandstill(const StandstillMeasurement& m) {
+void Eskf::Use(const StandstillMeasurement& m) {
   if (!initialized_ || m.t < nom_.x.t) return;
   Propagate(m.t);
   // The gyro mean since the last update observes the bias only if the whole interval was standing.

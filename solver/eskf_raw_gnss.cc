@@ -87,7 +87,7 @@ NuisanceRows RawGnssRows(const NavState& x, const Vec3& lever_b, const Vec3& ome
   return rows;
 }
 
-void Eskf::AddRawGnss(const RawGnssMeasurement& m) {
+void Eskf::Use(const RawGnssMeasurement& m) {
   if (!initialized_ || m.t < nom_.x.t || !m.nav) return;
   Propagate(m.t);
   FlushCovariance();

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <string>
+#include <variant>
 
 #include <nlohmann/json.hpp>
 
@@ -26,6 +27,17 @@ struct StateEstimate {
 
 using StateCallback = std::function<void(const StateEstimate&)>;
 
+// Every measurement an estimator takes besides the IMU: one alternative per type, registered here and
+// nowhere else. The estimators and the smoother's attachers visit it, so a type that one of them does not
+// handle is a compile error. In time order with the IMU samples, and:
+// - a GNSS velocity comes after the fix of the same epoch (if any);
+// - a standstill (the pipeline's detector: wheels at zero and IMU quiet, or IMU quiet without wheels) at
+//   most every 0.1 s while the vehicle stands, right after the IMU sample at its time;
+// - a raw GNSS epoch (core/gnss_raw.h) carries its own single-point fix, for an estimator that takes fixes
+//   only.
+using Measurement =
+    std::variant<GnssMeasurement, GnssVelocityMeasurement, WheelMeasurement, StandstillMeasurement, RawGnssMeasurement>;
+
 class Estimator {
  public:
   virtual ~Estimator() = default;
@@ -33,16 +45,7 @@ class Estimator {
   // Starts from a static initialisation; states are then emitted through the callback.
   virtual void Initialize(const InitResult& init) = 0;
   virtual void AddImu(const ImuSample& imu) = 0;
-  virtual void AddGnss(const GnssMeasurement& gnss) = 0;
-  // A GNSS velocity, after the fix of the same epoch (if any).
-  virtual void AddGnssVelocity(const GnssVelocityMeasurement& gnss_velocity) = 0;
-  virtual void AddWheel(const WheelMeasurement& wheel) = 0;
-  // The vehicle stands (the session's detector: wheels at zero and IMU quiet, or IMU quiet without
-  // wheels); sent at most every 0.1 s while it stands, right after the IMU sample at m.t.
-  virtual void AddStandstill(const StandstillMeasurement& m) = 0;
-  // A raw GNSS epoch (core/gnss_raw.h), in time order with the rest; it carries its own single-point fix for
-  // an estimator that takes fixes only.
-  virtual void AddRawGnss(const RawGnssMeasurement& m) = 0;
+  virtual void Add(const Measurement& m) = 0;
   // Before Initialize: a state at rest that the initialiser knows without a yaw (Initializer::RestStates),
   // in time order and before the initialisation's time; written to the forward outputs, and to the
   // two-sided ones with the yaw found later (solver/pre_init_output.h).

@@ -293,7 +293,7 @@ void EstimatorPipeline::DetectStandstill(double t) {
     m.acc_mean_b = standstill_->WindowMeanAcc();
     m.window_s = options_.standstill.window;
   }
-  Dispatch(&Estimator::AddStandstill, m);
+  Dispatch(&Estimator::Add, Measurement(m));
 }
 
 void EstimatorPipeline::AddWheel(const WheelRecord& o) {
@@ -315,7 +315,7 @@ void EstimatorPipeline::AddWheel(const WheelRecord& o) {
   } else if (!initialized_) {
     init_->AddWheel(w);
   } else {
-    Dispatch(&Estimator::AddWheel, w);
+    Dispatch(&Estimator::Add, Measurement(w));
   }
 }
 
@@ -403,9 +403,9 @@ void EstimatorPipeline::UseFix(const GnssRecord& g, const RawGnssMeasurement* ra
     RawGnssMeasurement with_fix = *raw;
     with_fix.has_fix = true;
     with_fix.fix = m;
-    Dispatch(&Estimator::AddRawGnss, with_fix);
+    Dispatch(&Estimator::Add, Measurement(std::move(with_fix)));
   } else {
-    Dispatch(&Estimator::AddGnss, m);
+    Dispatch(&Estimator::Add, Measurement(m));
   }
 }
 
@@ -426,7 +426,7 @@ void EstimatorPipeline::AddGnssVelocity(const GnssVelocityRecord& g) {
     init_->AddGnssVelocity(m);
     return;
   }
-  Dispatch(&Estimator::AddGnssVelocity, m);
+  Dispatch(&Estimator::Add, Measurement(m));
 }
 
 // --- Simulated GNSS outages ---------------------------------------------------------------------------------

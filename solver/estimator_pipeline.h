@@ -60,7 +60,7 @@ class EstimatorPipeline {
   // takes the feed's epochs dated up to its record's time, on GPS time: the tag less the receiver clock of
   // the epoch's fix, or of the last fix; Finish the rest), or given one by one, in time order. Each epoch's
   // single-point fix sets the world frame and initialises like a fix; then the epoch goes to every
-  // estimator (Estimator::AddRawGnss), with that fix when it has one (estimator_pipeline_raw.cc).
+  // estimator (Estimator::Add), with that fix when it has one (estimator_pipeline_raw.cc).
   void SetRawGnssFeed(std::unique_ptr<RawGnssFeed> feed);
   void AddRawGnss(RawGnssMeasurement m);
   // A log's record (or a simulated one) to the Add* of its type: the one dispatch before the estimators.

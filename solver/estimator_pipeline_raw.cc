@@ -123,7 +123,7 @@ void EstimatorPipeline::UseRawGnss(PreparedRawGnss p) {
     m.R_ecef_w = frame_->R_ecef_w();
   }
   if (!sol.ok) {
-    if (initialized_ && frame_) Dispatch(&Estimator::AddRawGnss, m);
+    if (initialized_ && frame_) Dispatch(&Estimator::Add, Measurement(m));
     return;
   }
   const GnssRecord fix = FixRecord(sol, m.t);

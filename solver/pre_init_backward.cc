@@ -98,12 +98,12 @@ std::vector<StateEstimate> FillBackward(const EstimatorOptions& options, const B
     } else if (e.kind == 1) {
       GnssMeasurement f = span.fixes[e.index];
       f.t = e.t;
-      eskf.AddGnss(f);
+      eskf.Add(f);
     } else {
       StandstillMeasurement m;
       m.t = e.t;
       m.since = e.since;
-      eskf.AddStandstill(m);
+      eskf.Add(m);
     }
   }
   eskf.Finish();

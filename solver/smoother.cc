@@ -262,24 +262,28 @@ Keyframe& Smoother::CreateKeyframe(double t) {
   return kf;
 }
 
-void Smoother::AddStandstill(const StandstillMeasurement& m) {
-  if (!initialized_ || m.t < window_.back().t) return;
-  if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
-  for (auto& attacher : attachers_) attacher->OnStandstill(m, context_);
+bool Smoother::Attach(const Measurement& m) {
+  bool solve = false;
+  for (auto& attacher : attachers_) solve = attacher->OnMeasurement(m, context_) || solve;
+  return solve;
 }
 
-void Smoother::AddGnssVelocity(const GnssVelocityMeasurement& m) {
-  if (!initialized_ || m.t < t_now_ - kSameEpoch || m.t < window_.back().t - kSameEpoch) return;
-  if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
-  bool attached = false;
-  for (auto& attacher : attachers_) attached = attacher->OnGnssVelocity(m, context_) || attached;
-  if (attached) solve_pending_ = true;
+void Smoother::Use(const StandstillMeasurement& x, const Measurement& m) {
+  if (!initialized_ || x.t < window_.back().t) return;
+  if (x.t > window_.back().t + kSameEpoch) SolveIfPending();
+  Attach(m);
 }
 
-void Smoother::AddWheel(const WheelMeasurement& w) {
+void Smoother::Use(const GnssVelocityMeasurement& x, const Measurement& m) {
+  if (!initialized_ || x.t < t_now_ - kSameEpoch || x.t < window_.back().t - kSameEpoch) return;
+  if (x.t > window_.back().t + kSameEpoch) SolveIfPending();
+  if (Attach(m)) solve_pending_ = true;
+}
+
+void Smoother::Use(const WheelMeasurement& x, const Measurement& m) {
   if (!initialized_ || !options_.wheel.enabled) return;
-  IntegrateTo(w.t);
-  for (auto& attacher : attachers_) attacher->OnWheel(w, context_);
+  IntegrateTo(x.t);
+  Attach(m);
 }
 
 bool Smoother::Solve() {

@@ -12,18 +12,17 @@
 // Outputs: the final estimate of each keyframe when it leaves the window, with the IMU-rate states between
 // it and the next keyframe (solver/smoother_output.h), and the newest keyframe after each solve (online).
 //
-// Robustness (config standstill.*, watchdog.*, imu.max_gap_s):
+// Standstills, IMU gaps and the watchdog behave as docs/robustness.md ("Field robustness") describes, in
+// both estimators alike (solver/estimator_common.h). Particular to the window:
 // - GNSS: a run of rejected fixes that agree with one another inflates the gate (GateInflation); a fix
 //   accepted under it makes the marginalisation prior's position uncertain by a common translation of its
 //   poses (the factor times its position covariance; attitude, velocity and biases kept), and joins
 //   without the robust loss, so the window moves to where the fixes are (re-acquisition after an outage or
 //   a step of the GNSS positions by design, not by the watchdog).
-// - IMU gap longer than imu.max_gap_s: preintegrated as a coast (no rotation, no acceleration from the
-//   current estimate) with the covariance of an unknown motion (kImuGap*, solver/estimator_common.h).
-// - Watchdog: decided as in the ESKF (GnssWatchdog, WatchdogVerdict: solver/estimator_common.h; the position
-//   σ is the larger of the prediction at the fix and the last marginalised keyframe's): the window is flushed
-//   to the output and rebuilt from a fresh prior at the current fix (ResetPositionFromFix; the scale and the
-//   time offset kept).
+// - an IMU gap is preintegrated as the coast (no rotation, no acceleration from the current estimate);
+// - the watchdog's position σ is the larger of the prediction at the fix and the last marginalised
+//   keyframe's; a reset flushes the window to the output and rebuilds it from a fresh prior at the current
+//   fix (ResetPositionFromFix; the scale and the time offset kept).
 #pragma once
 
 #include <ceres/ceres.h>
@@ -32,6 +31,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "core/preintegration.h"
@@ -57,15 +57,8 @@ class Smoother : public Estimator {
   std::string name() const override { return "smoother"; }
   void Initialize(const InitResult& init) override;
   void AddImu(const ImuSample& imu) override;
-  void AddGnss(const GnssMeasurement& gnss) override;
-  void AddGnssVelocity(const GnssVelocityMeasurement& gnss_velocity) override;
-  void AddWheel(const WheelMeasurement& wheel) override;
-  void AddStandstill(const StandstillMeasurement& m) override;
-  // The epoch's single-point fix and Doppler velocity, as a fix and a GNSS velocity: the smoother has no
-  // raw updates yet.
-  void AddRawGnss(const RawGnssMeasurement& m) override {
-    if (m.has_fix) AddGnss(m.fix);
-    if (m.has_velocity && options_.gnss.use_velocity) AddGnssVelocity(m.velocity);
+  void Add(const Measurement& m) override {
+    std::visit([&](const auto& x) { Use(x, m); }, m);
   }
   void AddRestState(const StateEstimate& s) override;
   void Finish() override;
@@ -77,6 +70,19 @@ class Smoother : public Estimator {
  private:
   static constexpr double kSameEpoch = 1e-6;  // s: a fix at a keyframe's time belongs to it
 
+  // The measurements, one overload per type of Measurement; m holds x, as the attachers take it.
+  void Use(const GnssMeasurement& x, const Measurement& m);  // smoother_gnss.cc
+  void Use(const GnssVelocityMeasurement& x, const Measurement& m);
+  void Use(const WheelMeasurement& x, const Measurement& m);
+  void Use(const StandstillMeasurement& x, const Measurement& m);
+  // The epoch's single-point fix and Doppler velocity, as a fix and a GNSS velocity: the smoother has no
+  // raw updates yet.
+  void Use(const RawGnssMeasurement& x, const Measurement& /*m*/) {
+    if (x.has_fix) Add(x.fix);
+    if (x.has_velocity && options_.gnss.use_velocity) Add(x.velocity);
+  }
+  // Offers m to every attacher; true if one asks for a solve before the next IMU sample.
+  bool Attach(const Measurement& m);
   void IntegrateTo(double t, const ImuSample* held = nullptr);
   Keyframe& CreateKeyframe(double t);
   // The attachers' services (AttachContext): the prediction at t, and the keyframe policy's anchor.
@@ -139,7 +145,7 @@ class Smoother : public Estimator {
   ceres::ResidualBlockId prior_id_ = nullptr;  // the marginalisation (or initial) prior
 
   GnssWatchdog watchdog_;
-  std::string reset_reason_;      // set by the checks, acted on at the end of AddGnss
+  std::string reset_reason_;      // set by the checks, acted on at the end of Use(GnssMeasurement)
   std::optional<GnssMeasurement> prev_fix_;
   CourseWait course_wait_;        // a rebuild waiting for a later fix's course
   double last_sigma_p_ = 0.0;     // largest position 1-σ of the last keyframe marginalised

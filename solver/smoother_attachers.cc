@@ -133,7 +133,7 @@ GnssAttacher::GnssAttacher(const GnssOptions& gnss, std::function<void(double, b
       loss_position_(std::isfinite(gate_position_) ? new ceres::HuberLoss(std::sqrt(gate_position_)) : nullptr),
       loss_heading_(std::isfinite(gate_heading_) ? new ceres::HuberLoss(std::sqrt(gate_heading_)) : nullptr) {}
 
-bool GnssAttacher::OnGnss(const GnssMeasurement& m, const AttachContext& ctx) {
+bool GnssAttacher::On(const GnssMeasurement& m, const AttachContext& ctx) {
   const Prediction pred = ctx.predict(m.t);
   const bool position = AttachPosition(m, pred, ctx);
   // A heading attached beside a rejected fix is a measurement too: the window must be solved for it.
@@ -242,7 +242,7 @@ GnssVelocityAttacher::GnssVelocityAttacher(const GnssOptions& gnss)
       gate_(Chi2Gate(gnss.gate_probability, 3)),
       loss_(std::isfinite(gate_) ? new ceres::HuberLoss(std::sqrt(gate_)) : nullptr) {}
 
-bool GnssVelocityAttacher::OnGnssVelocity(const GnssVelocityMeasurement& m, const AttachContext& ctx) {
+bool GnssVelocityAttacher::On(const GnssVelocityMeasurement& m, const AttachContext& ctx) {
   const Prediction pred = ctx.predict(m.t);
   const StateBlocks at(pred.x, ctx.keyframes);
   const Vec3 omega_b = ctx.BodyRate(pred.x);
@@ -282,9 +282,10 @@ StandstillAttacher::StandstillAttacher(const StandstillOptions& standstill, cons
       gate_(Chi2Gate(gate_probability, 3)),
       gate_zero_rate_(Chi2Gate(kZeroRateGateProbability, 3)) {}
 
-void StandstillAttacher::OnStandstill(const StandstillMeasurement& m, const AttachContext& ctx) {
+bool StandstillAttacher::On(const StandstillMeasurement& m, const AttachContext& ctx) {
   last_ = m;
   Attach(ctx.keyframes.back(), ctx);
+  return false;
 }
 
 void StandstillAttacher::Attach(Keyframe& kf, const AttachContext& ctx) {

@@ -27,6 +27,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <variant>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -92,12 +93,10 @@ class MeasurementAttacher {
  public:
   virtual ~MeasurementAttacher() = default;
 
-  // A measurement arrived (the smoother is initialised); true if a factor was attached (the window is
-  // then solved before the next IMU sample).
-  virtual bool OnGnss(const GnssMeasurement& /*m*/, const AttachContext& /*ctx*/) { return false; }
-  virtual bool OnGnssVelocity(const GnssVelocityMeasurement& /*m*/, const AttachContext& /*ctx*/) { return false; }
-  virtual void OnWheel(const WheelMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
-  virtual void OnStandstill(const StandstillMeasurement& /*m*/, const AttachContext& /*ctx*/) {}
+  // A measurement arrived (the smoother is initialised; every attacher sees every one, AttacherOf picks its
+  // type); true if the window is to be solved before the next IMU sample (a factor attached that the
+  // epoch's solve needs).
+  virtual bool OnMeasurement(const Measurement& m, const AttachContext& ctx) = 0;
   // An IMU step was integrated from the newest keyframe (before the keyframe it ends at, if any, is made).
   virtual void OnImuStep(const ImuStepView& /*step*/) {}
   // A keyframe became the newest, with its IMU and random-walk factors.
@@ -112,14 +111,25 @@ class MeasurementAttacher {
   virtual void AddStats(nlohmann::json* /*stats*/) const {}
 };
 
-class GnssAttacher final : public MeasurementAttacher {
+// The attacher of one measurement type M: On gets the measurements of that type, the others pass by.
+template <typename M>
+class AttacherOf : public MeasurementAttacher {
+ public:
+  bool OnMeasurement(const Measurement& m, const AttachContext& ctx) final {
+    const M* x = std::get_if<M>(&m);
+    return x != nullptr && On(*x, ctx);
+  }
+  virtual bool On(const M& m, const AttachContext& ctx) = 0;
+};
+
+class GnssAttacher final : public AttacherOf<GnssMeasurement> {
  public:
   // on_checked(t, accepted): each fix's outcome, for the smoother's watchdog; on_reacquired(factor): a fix
   // was accepted under an inflated gate (the window was overconfident by about that factor).
   GnssAttacher(const GnssOptions& gnss, std::function<void(double t, bool accepted)> on_checked,
                std::function<void(double factor)> on_reacquired);
 
-  bool OnGnss(const GnssMeasurement& m, const AttachContext& ctx) override;
+  bool On(const GnssMeasurement& m, const AttachContext& ctx) override;
   void OnWindowRebuilt() override { inflation_.Accepted(); }
   void OnResetFix(const GnssMeasurement& /*m*/) override { ++position_counts_.used; }
   void AddStats(nlohmann::json* stats) const override;
@@ -140,10 +150,10 @@ class GnssAttacher final : public MeasurementAttacher {
   MeasurementCounts position_counts_, heading_counts_;
 };
 
-class GnssVelocityAttacher final : public MeasurementAttacher {
+class GnssVelocityAttacher final : public AttacherOf<GnssVelocityMeasurement> {
  public:
   explicit GnssVelocityAttacher(const GnssOptions& gnss);
-  bool OnGnssVelocity(const GnssVelocityMeasurement& m, const AttachContext& ctx) override;
+  bool On(const GnssVelocityMeasurement& m, const AttachContext& ctx) override;
   void AddStats(nlohmann::json* stats) const override { (*stats)["gnss_velocity"] = counts_.ToJson(); }
 
  private:
@@ -153,12 +163,13 @@ class GnssVelocityAttacher final : public MeasurementAttacher {
   MeasurementCounts counts_;
 };
 
-class StandstillAttacher final : public MeasurementAttacher {
+class StandstillAttacher final : public AttacherOf<StandstillMeasurement> {
  public:
   // gate_probability: the zero velocity's χ² gate (standstill.* has none: the wheels', wheel.gate_probability).
   StandstillAttacher(const StandstillOptions& standstill, const ImuOptions& imu, double gate_probability);
 
-  void OnStandstill(const StandstillMeasurement& m, const AttachContext& ctx) override;
+  // False: its factors join the next solve.
+  bool On(const StandstillMeasurement& m, const AttachContext& ctx) override;
   void OnKeyframeCreated(Keyframe& kf, const AttachContext& ctx) override { Attach(kf, ctx); }
   void OnKeyframeLeaving(const Keyframe& kf) override { standing_.erase(kf.id); }
   // A standstill detected before the rebuild is not carried into the new window.

@@ -18,7 +18,7 @@
 
 namespace gins {
 
-void Smoother::AddGnss(const GnssMeasurement& m) {
+void Smoother::Use(const GnssMeasurement& m, const Measurement& measurement) {
   if (!initialized_ || m.t < t_now_ - kSameEpoch || m.t < window_.back().t - kSameEpoch) return;
   if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
   if (options_.watchdog.enabled) {
@@ -42,9 +42,7 @@ void Smoother::AddGnss(const GnssMeasurement& m) {
   reset_reason_.clear();
   const std::optional<GnssMeasurement> prev_fix = prev_fix_;
   prev_fix_ = m;
-  bool attached = false;
-  for (auto& attacher : attachers_) attached = attacher->OnGnss(m, context_) || attached;
-  if (attached) solve_pending_ = true;
+  if (Attach(measurement)) solve_pending_ = true;
   if (!reset_reason_.empty()) {
     prev_fix_ = prev_fix;  // the fix before this one, for the velocity
     SolveIfPending();

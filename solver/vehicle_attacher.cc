@@ -61,8 +61,8 @@ void VehicleAttacher::Add(Accumulator* acc, const WheelMeasurement& m, double fr
   }
 }
 
-void VehicleAttacher::OnWheel(const WheelMeasurement& m, const AttachContext& ctx) {
-  if (!options_.wheel.enabled || !open_ || m.interval <= 0.0) return;
+bool VehicleAttacher::On(const WheelMeasurement& m, const AttachContext& ctx) {
+  if (!options_.wheel.enabled || !open_ || m.interval <= 0.0) return false;
   ++wheel_records_;
   const double a = m.t - m.interval;  // the record counts over (a, m.t]
   double from = std::max(a, open_->t0);
@@ -75,7 +75,7 @@ void VehicleAttacher::OnWheel(const WheelMeasurement& m, const AttachContext& ct
     if (end > lo) Add(&*closing_, m, (end - lo) / m.interval, dR);
     from = std::max(from, *closing_t1_);
   }
-  if (m.t <= from) return;
+  if (m.t <= from) return false;
   // The attitude at the middle of this part, relative to the newest keyframe: the IMU's, turned back from
   // now by the body rate.
   const Keyframe& newest = ctx.keyframes.back();
@@ -85,6 +85,7 @@ void VehicleAttacher::OnWheel(const WheelMeasurement& m, const AttachContext& ct
   const Quat dR_now = x.q_wb.conjugate() * now.q_wb;
   const Quat dR_mid = dR_now * ExpQuat<double>(Vec3(-ctx.BodyRate(now) * (m.t - mid)));
   Add(&*open_, m, (m.t - from) / m.interval, dR_mid);
+  return false;
 }
 
 void VehicleAttacher::OnImuStep(const ImuStepView& step) {

@@ -21,11 +21,12 @@
 
 namespace gins {
 
-class VehicleAttacher final : public MeasurementAttacher {
+class VehicleAttacher final : public AttacherOf<WheelMeasurement> {
  public:
   explicit VehicleAttacher(const SensorOptions& options);  // wheel.*, vehicle.*; imu.* for the chord's gate
 
-  void OnWheel(const WheelMeasurement& m, const AttachContext& ctx) override;
+  // False: the records join the interval's odometer factor at the next keyframe.
+  bool On(const WheelMeasurement& m, const AttachContext& ctx) override;
   void OnImuStep(const ImuStepView& step) override;
   void OnKeyframeCreated(Keyframe& kf, const AttachContext& ctx) override;
   void OnWindowRebuilt() override;

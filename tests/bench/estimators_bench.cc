@@ -106,7 +106,7 @@ void BM_EskfGnssUpdate(benchmark::State& state) {
     m.t = x.t;
     m.p_w = x.p_wb + x.q_wb * Vec3(-0.17, -0.2, 0.0);
     m.yaw_G = 0.0;
-    f.eskf()->AddGnss(m);
+    f.eskf()->Add(m);
   }
 }
 BENCHMARK(BM_EskfGnssUpdate)->Arg(0)->Arg(1)->ArgName("heading");
@@ -132,15 +132,15 @@ void BM_EskfWheelUpdate(benchmark::State& state) {
   for (auto _ : state) {
     w.t = f.eskf()->state().t;
     w.speed = 0.0;
-    f.eskf()->AddWheel(w);
+    f.eskf()->Add(w);
   }
   CheckAllUsed(state, f.eskf()->Stats()["wheel"], used0 + (nhc ? 2 : 1) * state.iterations());
 }
 BENCHMARK(BM_EskfWheelUpdate)->Arg(0)->Arg(1)->ArgName("nhc");
 
-// Standstill update (AddStandstill): zero velocity and zero rate (the mean gyro reading since the last
+// Standstill update: zero velocity and zero rate (the mean gyro reading since the last
 // update observes the gyro bias). Each iteration first feeds, untimed, 0.1 s of quiet IMU samples (the
-// session sends a standstill every 0.1 s); only AddStandstill is timed (manual time).
+// session sends a standstill every 0.1 s); only the update is timed (manual time).
 void BM_EskfStandstillUpdate(benchmark::State& state) {
   EskfFixture f;
   Eskf* eskf = f.eskf();
@@ -159,7 +159,7 @@ void BM_EskfStandstillUpdate(benchmark::State& state) {
     }
     m.t = s.t;
     const auto t0 = std::chrono::steady_clock::now();
-    eskf->AddStandstill(m);
+    eskf->Add(m);
     const auto t1 = std::chrono::steady_clock::now();
     state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
   }
@@ -173,7 +173,13 @@ BENCHMARK(BM_EskfStandstillUpdate)->UseManualTime();
 
 // What a session passes to its estimators after initialisation, recorded once so that the step benchmark
 // feeds the smoother alone.
-using EstimatorInput = std::variant<ImuSample, GnssMeasurement, WheelMeasurement, StandstillMeasurement>;
+using EstimatorInput = std::variant<ImuSample, Measurement>;
+
+// The GNSS fix an input holds, or null.
+const GnssMeasurement* FixOf(const EstimatorInput& in) {
+  const Measurement* m = std::get_if<Measurement>(&in);
+  return m != nullptr ? std::get_if<GnssMeasurement>(m) : nullptr;
+}
 
 class Recorder : public Estimator {
  public:
@@ -181,11 +187,7 @@ class Recorder : public Estimator {
   std::string name() const override { return "recorder"; }
   void Initialize(const InitResult& init) override { *init_ = init; }
   void AddImu(const ImuSample& imu) override { inputs_->emplace_back(imu); }
-  void AddGnss(const GnssMeasurement& gnss) override { inputs_->emplace_back(gnss); }
-  void AddGnssVelocity(const GnssVelocityMeasurement&) override {}  // the step drive has no GNSS velocity
-  void AddRawGnss(const RawGnssMeasurement&) override {}            // nor raw observations
-  void AddWheel(const WheelMeasurement& wheel) override { inputs_->emplace_back(wheel); }
-  void AddStandstill(const StandstillMeasurement& m) override { inputs_->emplace_back(m); }
+  void Add(const Measurement& m) override { inputs_->emplace_back(m); }
   void AddRestState(const StateEstimate&) override {}
   void Finish() override {}
   nlohmann::json Stats() const override { return {}; }
@@ -198,9 +200,7 @@ class Recorder : public Estimator {
 struct FeedEstimator {
   Estimator* e;
   void operator()(const ImuSample& m) const { e->AddImu(m); }
-  void operator()(const GnssMeasurement& m) const { e->AddGnss(m); }
-  void operator()(const WheelMeasurement& m) const { e->AddWheel(m); }
-  void operator()(const StandstillMeasurement& m) const { e->AddStandstill(m); }
+  void operator()(const Measurement& m) const { e->Add(m); }
 };
 
 // TestDrive's sensors without outages and with heading on every fix; after the 20 s standstill and the
@@ -262,7 +262,7 @@ class SmootherFixture {
     while (next_ < in.inputs.size()) {
       const EstimatorInput& m = in.inputs[next_++];
       std::visit(FeedEstimator{&smoother_}, m);
-      if (std::holds_alternative<GnssMeasurement>(m) && std::get<GnssMeasurement>(m).t >= t_start) break;
+      if (const GnssMeasurement* fix = FixOf(m); fix != nullptr && fix->t >= t_start) break;
     }
     stats0_ = smoother_.Stats();
   }
@@ -270,7 +270,7 @@ class SmootherFixture {
   bool Step() {
     const auto& inputs = StepInputs().inputs;
     size_t end = next_;
-    while (end < inputs.size() && !std::holds_alternative<GnssMeasurement>(inputs[end])) ++end;
+    while (end < inputs.size() && FixOf(inputs[end]) == nullptr) ++end;
     if (end == inputs.size()) return false;
     for (; next_ <= end; ++next_) std::visit(FeedEstimator{&smoother_}, inputs[next_]);
     return true;

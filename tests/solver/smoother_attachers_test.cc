@@ -101,15 +101,15 @@ TEST_F(AttacherTest, GnssFixIsCheckedAgainstThePredictionAndAttachedAtItsEpoch) 
   std::vector<std::pair<double, bool>> outcomes;
   GnssAttacher gnss(options_.gnss, [&](double t, bool ok) { outcomes.emplace_back(t, ok); }, [](double) {});
   // 10 cm off: innovation χ² ≈ 0.1²/(0.05² + 0.02²) ≈ 3.4: accepted, at full weight.
-  EXPECT_TRUE(gnss.OnGnss(Fix(10.0, Vec3(100.1, 0.0, 0.0)), context_));
+  EXPECT_TRUE(gnss.On(Fix(10.0, Vec3(100.1, 0.0, 0.0)), context_));
   EXPECT_EQ(Residuals(), 1);
   // 1 m off: χ² ≈ 345, far beyond the 3-dof gate (21.1): rejected, nothing attached.
-  EXPECT_FALSE(gnss.OnGnss(Fix(10.0, Vec3(101.0, 0.0, 0.0)), context_));
+  EXPECT_FALSE(gnss.On(Fix(10.0, Vec3(101.0, 0.0, 0.0)), context_));
   EXPECT_EQ(Residuals(), 1);
   // The same 1 m with a window that is itself uncertain to 2 m (after an outage): accepted. A check with R
   // alone would have rejected it.
   sigma_p_ = 2.0;
-  EXPECT_TRUE(gnss.OnGnss(Fix(10.0, Vec3(101.0, 0.0, 0.0)), context_));
+  EXPECT_TRUE(gnss.On(Fix(10.0, Vec3(101.0, 0.0, 0.0)), context_));
   EXPECT_EQ(Residuals(), 2);
   ASSERT_EQ(outcomes.size(), 3u);
   EXPECT_TRUE(outcomes[0].second);
@@ -128,7 +128,7 @@ TEST_F(AttacherTest, AgreeingRejectedFixesReacquire) {
   // The estimate is 0.5 m off (an overconfident window after an outage): every fix agrees with the next.
   int accepted_at = -1;
   for (int k = 0; k < 10 && accepted_at < 0; ++k) {
-    if (gnss.OnGnss(Fix(0.0 + k, Vec3(0.5, 0.0, 0.0) + store_.back().State().p_wb), context_)) accepted_at = k;
+    if (gnss.On(Fix(0.0 + k, Vec3(0.5, 0.0, 0.0) + store_.back().State().p_wb), context_)) accepted_at = k;
   }
   EXPECT_GT(accepted_at, 0);
   EXPECT_LE(accepted_at, 6);  // 2^k doubt: (0.5/0.028)² ≈ 320 over a gate of 21 needs k ≈ 4
@@ -144,7 +144,7 @@ TEST_F(AttacherTest, ScatteredOutliersDoNotReacquire) {
   // 20 m outliers in directions that change every time: never a run that agrees.
   for (int k = 0; k < 12; ++k) {
     const double a = 2.1 * k;
-    EXPECT_FALSE(gnss.OnGnss(Fix(k, store_.back().State().p_wb + 20.0 * Vec3(std::cos(a), std::sin(a), 0.0)),
+    EXPECT_FALSE(gnss.On(Fix(k, store_.back().State().p_wb + 20.0 * Vec3(std::cos(a), std::sin(a), 0.0)),
                              context_));
   }
   EXPECT_EQ(Stats(gnss)["gnss_reacquired"], 0);
@@ -154,19 +154,19 @@ TEST_F(AttacherTest, StandstillIsCheckedAgainstThePredictedVelocity) {
   options_.standstill.max_speed = 0.5;
   StandstillAttacher standstill(options_.standstill, options_.imu, options_.wheel.gate_probability);
   Keyframe& a = Push(20.0, 0.01);
-  standstill.OnStandstill({20.0, 18.0}, context_);
+  standstill.On({20.0, 18.0}, context_);
   EXPECT_EQ(Residuals(), 1);  // the zero velocity
   Keyframe& b = Push(20.5, 0.01);
   b.steps_from_prev = Steps(0.0, 0.5);  // the gyro reads no rotation
   standstill.OnKeyframeCreated(b, context_);
   EXPECT_EQ(Residuals(), 1);  // the last detection (20.0) is too old for it
-  standstill.OnStandstill({20.5, 18.0}, context_);
+  standstill.On({20.5, 18.0}, context_);
   EXPECT_EQ(Residuals(), 3);  // its zero velocity and the zero motion from a
   EXPECT_TRUE(b.still_from_prev);
   (void)a;
   // A "standstill" the prediction contradicts (0.3 m/s with a velocity σ of 1 mm/s) is not taken.
   Keyframe& c = Push(21.0, 0.3);
-  standstill.OnStandstill({21.0, 18.0}, context_);
+  standstill.On({21.0, 18.0}, context_);
   EXPECT_EQ(Residuals(), 3);
   (void)c;
   const nlohmann::json s = Stats(standstill);
@@ -182,10 +182,10 @@ TEST_F(AttacherTest, StandstillIsCheckedAgainstThePredictedVelocity) {
 TEST_F(AttacherTest, StandingButTurningKeepsTheRotationFree) {
   StandstillAttacher standstill(options_.standstill, options_.imu, options_.wheel.gate_probability);
   Push(20.0, 0.0);
-  standstill.OnStandstill({20.0, 18.0}, context_);
+  standstill.On({20.0, 18.0}, context_);
   Keyframe& b = Push(20.5, 0.0);
   b.steps_from_prev = Steps(0.02, 0.5);
-  standstill.OnStandstill({20.5, 18.0}, context_);
+  standstill.On({20.5, 18.0}, context_);
   EXPECT_EQ(Residuals(), 3);  // two zero velocities and the zero motion
   EXPECT_FALSE(b.still_from_prev);
   const nlohmann::json s = Stats(standstill);
@@ -211,10 +211,10 @@ TEST_F(AttacherTest, OdometerIntegratesEveryRecordAndSplitsTheOneAcrossAKeyframe
   // Keyframes at 0, 1 and 2 s; records every 0.1 s from 0.05 s, so the record at 1.05 s straddles 1.0 s.
   Keyframe& k0 = Push(0.0, 10.0);
   odometer_only.OnKeyframeCreated(k0, context_);
-  for (double t = 0.05; t < 1.0; t += 0.1) odometer_only.OnWheel(Wheel(t, 10.0), context_);
+  for (double t = 0.05; t < 1.0; t += 0.1) odometer_only.On(Wheel(t, 10.0), context_);
   Keyframe& k1 = Push(1.0, 10.0);
   odometer_only.OnKeyframeCreated(k1, context_);
-  for (double t = 1.05; t < 2.0; t += 0.1) odometer_only.OnWheel(Wheel(t, 10.0), context_);
+  for (double t = 1.05; t < 2.0; t += 0.1) odometer_only.On(Wheel(t, 10.0), context_);
   const int before = Residuals();
   // The joint covariance of k0 and k1 after a "solve".
   const int n = static_cast<int>(NavIndexOfTangent(store_.EstimatedTypes()).size());

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -111,9 +112,10 @@ TEST(DocsReferences, NoDocumentNamesTheDesignDocument) {
   }
 }
 
-TEST(DocsReferences, EveryPathInBackticksExists) {
-  int checked = 0;
-  for (const Doc& doc : ReadDocs()) {
+// Calls f(doc, line number, span) for every code span of every document, fenced blocks left out.
+template <typename F>
+void ForEachSpan(const std::vector<Doc>& docs, F f) {
+  for (const Doc& doc : docs) {
     bool fenced = false;
     for (size_t i = 0; i < doc.lines.size(); ++i) {
       const std::string& line = doc.lines[i];
@@ -123,15 +125,123 @@ TEST(DocsReferences, EveryPathInBackticksExists) {
         continue;
       }
       if (fenced) continue;
-      for (const std::string& span : CodeSpans(line)) {
-        if (!LooksLikePath(span)) continue;
-        ++checked;
-        const std::string why = CheckPath(span);
-        EXPECT_TRUE(why.empty()) << doc.name << ":" << i + 1 << ": `" << span << "` " << why;
+      for (const std::string& span : CodeSpans(line)) f(doc, i + 1, span);
+    }
+  }
+}
+
+bool IsIdentifier(const std::string& s) {
+  if (s.empty() || std::isdigit(static_cast<unsigned char>(s[0]))) return false;
+  return std::all_of(s.begin(), s.end(), IsWordChar);
+}
+
+// CamelCase of two humps or more (`EstimatorPipeline`, `GnssRecord`), or a constant (`kBlockSpecs`): a name
+// only code has. One hump (`Update`, `IMU`) is as likely an English word or a log token.
+bool LooksLikeTypeOrConstant(const std::string& s) {
+  if (s.size() > 2 && s[0] == 'k' && std::isupper(static_cast<unsigned char>(s[1]))) return true;
+  int humps = 0;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (!std::isupper(static_cast<unsigned char>(s[i]))) continue;
+    const bool followed = i + 1 < s.size() && std::isupper(static_cast<unsigned char>(s[i + 1])) == 0 &&
+                          IsWordChar(s[i + 1]) && s[i + 1] != '_';
+    if (!followed) return false;  // an upper-case run (`IMU`, `GNSS`) is no CamelCase
+    ++humps;
+  }
+  return humps >= 2 && std::isupper(static_cast<unsigned char>(s[0]));
+}
+
+// The parts of a span that names a C++ symbol (`Eskf::Update`, `LogRecord::Type::kWheel`, `Smoother::Solve()`,
+// `EstimatorPipeline`, `kBlockSpecs`), the namespaces of gins and its libraries left out; empty for any other span.
+std::vector<std::string> SymbolParts(std::string s) {
+  if (EndsWith(s, "()")) s.resize(s.size() - 2);
+  std::vector<std::string> parts;
+  for (size_t from = 0;;) {
+    const size_t at = s.find("::", from);
+    std::string part = s.substr(from, at == std::string::npos ? std::string::npos : at - from);
+    if (!part.empty() && part[0] == '~') part.erase(0, 1);
+    if (!IsIdentifier(part)) return {};
+    parts.push_back(part);
+    if (at == std::string::npos) break;
+    from = at + 2;
+  }
+  if (parts.size() == 1 && !LooksLikeTypeOrConstant(parts[0])) return {};
+  for (const char* ns : {"std", "ceres", "Eigen", "GeographicLib", "gins"}) {
+    if (parts.size() > 1 && parts[0] == ns) parts.erase(parts.begin());
+  }
+  return parts;
+}
+
+// Every word of the code: the sources, tests, scripts and examples; not this file, whose strings name symbols
+// that must not exist.
+std::set<std::string> CodeWords() {
+  std::set<std::string> words;
+  std::vector<fs::path> files = {kSourceDir / "CMakeLists.txt"};
+  for (const char* dir : {"core", "factors", "solver", "config", "apps", "tests", "scripts", "examples"}) {
+    for (const auto& e : fs::recursive_directory_iterator(kSourceDir / dir)) {
+      const std::string ext = e.path().extension().string();
+      const bool code = ext == ".h" || ext == ".cc" || ext == ".py" || ext == ".in" || ext == ".sh";
+      if (e.is_regular_file() && code && e.path().filename() != "docs_references_test.cc") {
+        files.push_back(e.path());
       }
     }
   }
+  for (const fs::path& f : files) {
+    const std::string text = test::ReadFile(f.string());
+    for (size_t i = 0; i < text.size();) {
+      if (!IsWordChar(text[i])) {
+        ++i;
+        continue;
+      }
+      size_t j = i;
+      while (j < text.size() && IsWordChar(text[j])) ++j;
+      words.insert(text.substr(i, j - i));
+      i = j;
+    }
+  }
+  return words;
+}
+
+TEST(DocsReferences, EveryPathInBackticksExists) {
+  int checked = 0;
+  ForEachSpan(ReadDocs(), [&](const Doc& doc, size_t line, const std::string& span) {
+    if (!LooksLikePath(span)) return;
+    ++checked;
+    const std::string why = CheckPath(span);
+    EXPECT_TRUE(why.empty()) << doc.name << ":" << line << ": `" << span << "` " << why;
+  });
   EXPECT_GT(checked, 100);  // the docs name well over a hundred files: the scan sees them
+}
+
+// A symbol the docs name in backticks is in the code: a renamed or removed one fails here, naming the line.
+TEST(DocsReferences, EverySymbolInBackticksExists) {
+  const std::set<std::string> words = CodeWords();
+  int checked = 0;
+  ForEachSpan(ReadDocs(), [&](const Doc& doc, size_t line, const std::string& span) {
+    const std::vector<std::string> parts = SymbolParts(span);
+    if (parts.empty()) return;
+    ++checked;
+    for (const std::string& part : parts) {
+      EXPECT_TRUE(words.count(part) > 0) << doc.name << ":" << line << ": `" << span << "`: no " << part
+                                         << " in the code";
+    }
+  });
+  EXPECT_GT(checked, 50);  // the docs name many symbols: the scan sees them
+}
+
+TEST(DocsReferences, SymbolCheckTellsSymbolsFromWords) {
+  EXPECT_EQ(SymbolParts("Eskf::Update"), (std::vector<std::string>{"Eskf", "Update"}));
+  EXPECT_EQ(SymbolParts("LogRecord::Type::kWheel"), (std::vector<std::string>{"LogRecord", "Type", "kWheel"}));
+  EXPECT_EQ(SymbolParts("Smoother::Solve()"), (std::vector<std::string>{"Smoother", "Solve"}));
+  EXPECT_EQ(SymbolParts("std::variant"), (std::vector<std::string>{"variant"}));
+  EXPECT_EQ(SymbolParts("EstimatorPipeline"), (std::vector<std::string>{"EstimatorPipeline"}));
+  EXPECT_EQ(SymbolParts("kBlockSpecs"), (std::vector<std::string>{"kBlockSpecs"}));
+  for (const char* not_symbol :
+       {"Update", "IMU", "GNSS", "RTKLIB", "gins run", "core/io/log_reader.h", "a::", "3::4"}) {
+    EXPECT_TRUE(SymbolParts(not_symbol).empty()) << not_symbol;
+  }
+  const std::set<std::string> words = CodeWords();
+  EXPECT_EQ(words.count("EstimatorPipeline"), 1u);
+  EXPECT_EQ(words.count("Inject"), 0u);  // the name a recipe once cited for a function that did not exist
 }
 
 TEST(DocsReferences, PathCheckTellsRepositoryPathsFromOthers) {

@@ -201,8 +201,8 @@ int RunCli(int argc, const char* const* argv, bool own_process) {
       api::Config config = api::Config::FromFile(config_path);
       if (!obs_path.empty() || !nav_path.empty()) {
         Options options = api::internal::Access::options(config);
-        if (!obs_path.empty()) options.gnss.raw.obs_file = obs_path;
-        if (!nav_path.empty()) options.gnss.raw.nav_file = nav_path;
+        if (!obs_path.empty()) options.sensors.gnss.raw.obs_file = obs_path;
+        if (!nav_path.empty()) options.sensors.gnss.raw.nav_file = nav_path;
         config = api::internal::Access::MakeConfig(options);
       }
       req.config_path = config_path;

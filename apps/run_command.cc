@@ -197,7 +197,8 @@ nlohmann::json RunSummary(const Options& options, const RunRequest& request, con
                              session_stats["gnss_outages"]["fixes_kept_before_initialization"]}};
   j["gnss_gaps"] = session_stats["gnss_outages"]["log_gaps"];
   if (request.truth_path) j["truth"] = AbsolutePath(*request.truth_path);
-  j["gnss_lever_arm_m"] = {options.gnss.lever_b.x(), options.gnss.lever_b.y(), options.gnss.lever_b.z()};
+  const Vec3& lever = options.sensors.gnss.lever_b;
+  j["gnss_lever_arm_m"] = {lever.x(), lever.y(), lever.z()};
   j["faults"] = FaultsJson(j, session_stats);
   if (session_stats.contains("warnings")) j["warnings"] = session_stats["warnings"];
   if (session_stats.contains("turn_rate_check")) j["input"]["turn_rate_check"] = session_stats["turn_rate_check"];
@@ -356,7 +357,7 @@ RunResult Run(const api::Config& config, const RunRequest& request) {
       CheckInitTimeout(request.log_path, options.init.max_wait, session);
     }
   }
-  CheckReadCounts(request.log_path, read_stats, !options.gnss.raw.obs_file.empty());
+  CheckReadCounts(request.log_path, read_stats, !options.sensors.gnss.raw.obs_file.empty());
   FinishSession(request.log_path, &session);
   writer.Close();  // every state written (or the writer's error thrown) before the files are committed
   if (request.poll) request.poll();  // and after the two-sided passes Finish runs

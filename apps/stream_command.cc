@@ -206,7 +206,7 @@ int RunStream(const StreamRequest& req, int in_fd, std::FILE* out) {
       CheckInitTimeout(kInputName, max_wait, session);
     }
     const ReadStats& read_stats = api::internal::Access::read_stats(reader);
-    CheckReadCounts(kInputName, read_stats, !api::internal::Access::options(config).gnss.raw.obs_file.empty());
+    CheckReadCounts(kInputName, read_stats, !api::internal::Access::options(config).sensors.gnss.raw.obs_file.empty());
     FinishSession(kInputName, &session);
     Report(read_stats, lines, stream, reader.stopped() ? signals.Received() : 0);
     return 0;

@@ -252,12 +252,12 @@ inline constexpr auto kSimulateKeys = [](auto& v, SimOptions& o) {
 // The sections of a config file, in file order.
 inline constexpr auto kOptionsKeys = [](auto& v, Options& o) {
   v.Section("input", o.input, kInputKeys);
-  v.Section("imu", o.imu, kImuKeys);
-  v.Section("gnss", o.gnss, kGnssKeys);
-  v.Section("raw_gnss", o.gnss.raw, kRawGnssInputKeys);
-  v.Section("wheel", o.wheel, kWheelKeys);
-  v.Section("vehicle", o.vehicle, kVehicleKeys);
-  v.Section("gravity", o.gravity, kGravityKeys);
+  v.Section("imu", o.sensors.imu, kImuKeys);
+  v.Section("gnss", o.sensors.gnss, kGnssKeys);
+  v.Section("raw_gnss", o.sensors.gnss.raw, kRawGnssInputKeys);
+  v.Section("wheel", o.sensors.wheel, kWheelKeys);
+  v.Section("vehicle", o.sensors.vehicle, kVehicleKeys);
+  v.Section("gravity", o.sensors.gravity, kGravityKeys);
   v.Section("init", o.init, kInitKeys);
   v.Section("eskf", o.eskf, kEskfKeys);
   v.Section("smoother", o.smoother, kSmootherKeys);

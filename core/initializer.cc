@@ -64,25 +64,28 @@ std::string Deg(double rad) {
 
 }  // namespace
 
-Initializer::Initializer(const InitializerOptions& options, const EarthModel& earth)
-    : options_(options),
+Initializer::Initializer(const SensorOptions& sensors, const InitOptions& init, const StandstillOptions& standstill,
+                         const EarthModel& earth)
+    : sensors_(sensors),
+      init_options_(init),
+      standstill_options_(standstill),
       earth_(earth),
       detector_(
           [&] {
-            StandstillOptions o = options.standstill;
+            StandstillOptions o = standstill;
             o.enabled = true;  // the estimators' updates may be off; the static path still needs to know
-            o.window = options.init.static_duration;
+            o.window = init.static_duration;
             return o;
           }(),
-          earth.g_norm(), options.wheel.interval) {
-  align_options_.sensors = options;
-  align_options_.zero_velocity_sigma = options.standstill.velocity_sigma;
+          earth.g_norm(), sensors.wheel.interval) {
+  align_options_.sensors = sensors;
+  align_options_.zero_velocity_sigma = standstill.velocity_sigma;
 }
 
 void Initializer::AddImu(const ImuSample& imu) {
   if (done()) return;
   if (first_time_ < 0.0) first_time_ = imu.t;
-  if (!imu_.empty() && imu.t - imu_.back().t > options_.imu.max_gap) {
+  if (!imu_.empty() && imu.t - imu_.back().t > sensors_.imu.max_gap) {
     // Nothing is integrated across an IMU gap: the window starts again after it.
     imu_.clear();
     standing_.reset();
@@ -96,7 +99,7 @@ void Initializer::AddImu(const ImuSample& imu) {
 }
 
 void Initializer::AddWheel(const WheelMeasurement& wheel) {
-  if (done() || !options_.wheel.enabled) return;
+  if (done() || !sensors_.wheel.enabled) return;
   wheels_.push_back(wheel);
   detector_.AddWheel(wheel);
 }
@@ -113,7 +116,7 @@ void Initializer::Prune(double t) {
   while (!fixes_.empty() && t - fixes_.front().t > keep) fixes_.pop_front();
   while (!gnss_velocities_.empty() && t - gnss_velocities_.front().t > keep) gnss_velocities_.pop_front();
   while (!wheels_.empty() && t - wheels_.front().t > keep) wheels_.pop_front();
-  const double keep_history = options_.init.max_wait + kMaxWindow;
+  const double keep_history = init_options_.max_wait + kMaxWindow;
   while (!history_imu_.empty() && t - history_imu_.front().t > keep_history) history_imu_.pop_front();
   while (!history_fixes_.empty() && t - history_fixes_.front().t > keep_history) history_fixes_.pop_front();
 }
@@ -169,7 +172,7 @@ void Initializer::TrackStandstill(const ImuSample& imu) {
 
 void Initializer::CloseStandstill() {
   // A gentle start hides in the newest fifth of the detector's window for a while: leave that part out.
-  const double t_cut = standing_->summary.t_end - 0.2 * options_.init.static_duration;
+  const double t_cut = standing_->summary.t_end - 0.2 * init_options_.static_duration;
   double t_end = standing_->summary.t_start;
   for (const ImuSample& s : imu_) {
     if (s.t > t_cut && s.t <= standing_->summary.t_end) Accumulate(s, -1.0);
@@ -177,7 +180,7 @@ void Initializer::CloseStandstill() {
   }
   Standstill st = std::move(*standing_);
   standing_.reset();
-  if (t_end - st.summary.t_start < 0.5 * options_.init.static_duration || st.summary.n < 2) return;
+  if (t_end - st.summary.t_start < 0.5 * init_options_.static_duration || st.summary.n < 2) return;
   st.summary.t_end = t_end;
   Summarize(&st);
   while (!st.fixes.empty() && st.fixes.back().t > t_end) st.fixes.pop_back();
@@ -194,7 +197,7 @@ void Initializer::AddGnss(const GnssMeasurement& fix) {
     return;
   }
   if (standing_ && standing_->fixes.size() < kMaxStandstillFixes) standing_->fixes.push_back(fix);
-  const bool heading = options_.gnss.use_heading && fix.heading_valid;
+  const bool heading = sensors_.gnss.use_heading && fix.heading_valid;
   if (standing_) {
     if (heading) {
       TryStandingWithHeading(fix);
@@ -204,7 +207,7 @@ void Initializer::AddGnss(const GnssMeasurement& fix) {
     }
     return;
   }
-  if (options_.init.wait_for_heading && !heading) {
+  if (init_options_.wait_for_heading && !heading) {
     last_problem_ = "waiting for a valid dual-antenna heading (init.wait_for_heading: true)";
     return;
   }
@@ -243,7 +246,7 @@ bool Initializer::BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bo
   for (const GnssMeasurement& f : fixes_) sigmas.push_back(f.sigma_w.head<2>().norm() / std::sqrt(2.0));
   std::nth_element(sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
   const double length =
-      ImuWindowForSigma(options_.imu, earth_.g_norm(), sigmas[sigmas.size() / 2], kMinWindow, kMaxWindow);
+      ImuWindowForSigma(sensors_.imu, earth_.g_norm(), sigmas[sigmas.size() / 2], kMinWindow, kMaxWindow);
   double t0 = std::max(imu_.front().t, fix.t - length);
   *from_standstill = last_standstill_ && last_standstill_->summary.t_end >= t0;
   if (*from_standstill) {
@@ -273,7 +276,7 @@ bool Initializer::BuildWindow(const GnssMeasurement& fix, AlignmentInput* in, bo
   // Without motion the fit knows no more than a standstill would (and a quiet IMU may become one).
   if (!Moved(*in)) {
     last_problem_ = "the GNSS shows no motion and no standstill is confirmed yet (IMU quiet for " +
-                    std::to_string(options_.init.static_duration) + " s and a witness)";
+                    std::to_string(init_options_.static_duration) + " s and a witness)";
     return false;
   }
   return true;
@@ -308,8 +311,8 @@ bool FitStartsEstimators(const AlignmentFit& a, bool window_full, double max_att
 }
 
 bool Initializer::Acceptable(const AlignmentFit& a, bool window_full) {
-  const double max_att = options_.init.max_attitude_sigma;
-  const double max_tilt = std::hypot(max_att, options_.imu.init_acc_bias_sigma / earth_.g_norm());
+  const double max_att = init_options_.max_attitude_sigma;
+  const double max_tilt = std::hypot(max_att, sensors_.imu.init_acc_bias_sigma / earth_.g_norm());
   const double chi2_1 = Chi2Quantile(kAmbiguityProbability, 1);
   std::ostringstream os;
   os << "moving; the last fit (" << a.fixes_used << " fixes) gives yaw σ " << Deg(a.yaw_sigma) << " deg (needs ≤ "
@@ -378,7 +381,7 @@ void Initializer::RestStates(double after, std::vector<RestState>* out) const {
   RestState r;
   // Level from gravity; an accelerometer bias tilts the measured gravity by up to its σ over g.
   const double g = earth_.g_norm();
-  const double tilt = std::hypot(options_.imu.init_acc_bias_sigma / g,
+  const double tilt = std::hypot(sensors_.imu.init_acc_bias_sigma / g,
                                  st.acc_std.mean() / std::sqrt(std::max(1, st.n)) / g);
   const Quat q_level = Quat::FromTwoVectors(st.acc_mean.normalized(), Vec3::UnitZ());
   const Quat q0 = (QuatFromYaw(-YawOfXAxis<double>(q_level.toRotationMatrix())) * q_level).normalized();
@@ -391,8 +394,8 @@ void Initializer::RestStates(double after, std::vector<RestState>* out) const {
   const double rate_h = rate_w.head<2>().norm();
   if (rate_h > 0.0 && st.t_end > st.t_start) {
     const Vec3 u = q0 * st.gyro_mean;
-    const double noise = options_.imu.gyro_noise_density / std::sqrt(st.t_end - st.t_start);
-    const double sigma_h = std::sqrt(std::pow(options_.imu.init_gyro_bias_sigma, 2) + noise * noise +
+    const double noise = sensors_.imu.gyro_noise_density / std::sqrt(st.t_end - st.t_start);
+    const double sigma_h = std::sqrt(std::pow(sensors_.imu.init_gyro_bias_sigma, 2) + noise * noise +
                                      std::pow(tilt * rate_w.z(), 2));
     if (sigma_h / rate_h <= kMaxGyrocompassSigma) {
       yaw = WrapAngle(std::atan2(rate_w.y(), rate_w.x()) - std::atan2(u.y(), u.x()));
@@ -400,10 +403,10 @@ void Initializer::RestStates(double after, std::vector<RestState>* out) const {
     }
   }
   // A dual-antenna heading at this standstill (the newest valid one) is better still.
-  if (options_.gnss.use_heading) {
+  if (sensors_.gnss.use_heading) {
     for (auto f = standing_->fixes.rbegin(); f != standing_->fixes.rend(); ++f) {
       if (!f->heading_valid) continue;
-      const double m = options_.gnss.mount_yaw;
+      const double m = sensors_.gnss.mount_yaw;
       const Vec3 x_G = q0 * Vec3(std::cos(m), std::sin(m), 0.0);  // the antennas' baseline, level, yaw 0
       yaw = WrapAngle(f->yaw_G - std::atan2(x_G.y(), x_G.x()));
       yaw_sigma = f->sigma_yaw;
@@ -422,7 +425,7 @@ void Initializer::RestStates(double after, std::vector<RestState>* out) const {
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
     median[k] = v[v.size() / 2];
   }
-  const double gate = options_.gnss.gate_probability > 0.0 ? Chi2Quantile(options_.gnss.gate_probability, 3)
+  const double gate = sensors_.gnss.gate_probability > 0.0 ? Chi2Quantile(sensors_.gnss.gate_probability, 3)
                                                             : std::numeric_limits<double>::infinity();
   Vec3 info = Vec3::Zero(), sum = Vec3::Zero();
   for (const GnssMeasurement& f : fixes) {
@@ -436,12 +439,12 @@ void Initializer::RestStates(double after, std::vector<RestState>* out) const {
   // The IMU point: the lever arm's vertical part is known from the tilt; its horizontal part turns with the
   // yaw (for an unknown yaw a circle about the antenna: a mean of zero, a variance of half its squared
   // radius; else its arc over the yaw's σ).
-  const Vec3 lever_w = r.x.q_wb * options_.gnss.lever_b;
+  const Vec3 lever_w = r.x.q_wb * sensors_.gnss.lever_b;
   const bool yaw_known = yaw_sigma < kUnknownYawSigma;
   r.x.p_wb = p_antenna - (yaw_known ? lever_w : Vec3(0.0, 0.0, lever_w.z()));
   const double lever_var = lever_w.head<2>().squaredNorm() * (yaw_known ? yaw_sigma * yaw_sigma : 0.5);
   r.sigma_p = (info.cwiseInverse() + Vec3(lever_var, lever_var, 0.0)).cwiseSqrt();
-  r.sigma_v.setConstant(options_.standstill.velocity_sigma);
+  r.sigma_v.setConstant(standstill_options_.velocity_sigma);
   r.sigma_att = Vec3(tilt, tilt, yaw_sigma);
   const size_t first = out->size();
   for (auto it = imu_.rbegin(); it != imu_.rend() && it->t > after; ++it) {
@@ -464,7 +467,7 @@ std::string Initializer::Diagnosis() const {
        << last_standstill_->summary.t_end << ", ";
   }
   os << "initialisation did not complete: " << (last_problem_.empty() ? "no GNSS fix after it" : last_problem_);
-  if (options_.init.wait_for_heading) os << " (set init.wait_for_heading: false to take the yaw from the motion)";
+  if (init_options_.wait_for_heading) os << " (set init.wait_for_heading: false to take the yaw from the motion)";
   return os.str();
 }
 

@@ -53,12 +53,6 @@ struct InitOptions {
   double max_attitude_sigma = 1.0 * kDegToRad;
 };
 
-// What the initialisation needs: the sensors, its own settings and the standstill detector's.
-struct InitializerOptions : SensorOptions {
-  InitOptions init;
-  StandstillOptions standstill;
-};
-
 struct InitResult {
   NavState x0;                    // at x0.t, the GNSS epoch that completed the initialisation
   Mat15 P0 = Mat15::Identity();   // covariance in the NavState tangent (δp, δv, δθ, δbg, δba)
@@ -100,9 +94,13 @@ struct RestState {
 
 class Initializer {
  public:
-  Initializer(const InitializerOptions& options, const EarthModel& earth);
+  // The sensors, its own settings (init.*) and the standstill detector's (standstill.*).
+  Initializer(const SensorOptions& sensors, const InitOptions& init, const StandstillOptions& standstill,
+              const EarthModel& earth);
   // The flat Earth with constant gravity of magnitude g_norm.
-  Initializer(const InitializerOptions& options, double g_norm) : Initializer(options, EarthModel(g_norm)) {}
+  Initializer(const SensorOptions& sensors, const InitOptions& init, const StandstillOptions& standstill,
+              double g_norm)
+      : Initializer(sensors, init, standstill, EarthModel(g_norm)) {}
 
   // In time order; GNSS in w.
   void AddImu(const ImuSample& imu);
@@ -142,7 +140,9 @@ class Initializer {
   void Finish(const AlignmentFit& a, const GnssMeasurement& fix, const std::optional<Standstill>& standstill,
               std::vector<ImuSample> fit_imu);
 
-  InitializerOptions options_;
+  SensorOptions sensors_;
+  InitOptions init_options_;
+  StandstillOptions standstill_options_;
   EarthModel earth_;
   AlignmentOptions align_options_;
   StandstillDetector detector_;

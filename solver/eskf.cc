@@ -23,23 +23,32 @@ constexpr int kTd = eskf::Offset(Block::kTd);
 namespace {
 
 // Whether any passive block (δs, td) has a variance: if none, their rows and columns of P are zero for good.
-bool PassiveEstimated(const EstimatorOptions& o) {
+bool PassiveEstimated(const SensorOptions& o) {
   return OdometerScaleEstimated(o) || o.gnss.estimate_time_offset;
 }
 
 }  // namespace
 
-Eskf::Eskf(const EstimatorOptions& options, StateCallback on_state, StateCallback on_rts)
-    : options_(options), on_state_(std::move(on_state)), on_rts_(std::move(on_rts)), watchdog_(options.watchdog) {
-  gate_gnss_ = Chi2Gate(options_.gnss.gate_probability, 3);
-  gate_heading_ = Chi2Gate(options_.gnss.gate_probability, 1);
+Eskf::Eskf(const SensorOptions& sensors, const EskfOptions& eskf, const StandstillOptions& standstill,
+           const WatchdogOptions& watchdog, StateCallback on_state, StateCallback on_rts)
+    : sensors_(sensors),
+      eskf_options_(eskf),
+      standstill_options_(standstill),
+      watchdog_options_(watchdog),
+      on_state_(std::move(on_state)),
+      on_rts_(std::move(on_rts)),
+      watchdog_(watchdog) {
+  gate_gnss_ = Chi2Gate(sensors_.gnss.gate_probability, 3);
+  gate_heading_ = Chi2Gate(sensors_.gnss.gate_probability, 1);
   raw_.w_max = std::sqrt(gate_heading_);
-  gate_wheel_ = Chi2Gate(options_.wheel.gate_probability, 1);
-  gate_nhc_ = Chi2Gate(options_.wheel.gate_probability, 2);
-  gate_wheel_yaw_ = Chi2Gate(options_.wheel.gate_probability, 1);
-  gate_zupt_ = Chi2Gate(options_.wheel.gate_probability, 3);
+  gate_wheel_ = Chi2Gate(sensors_.wheel.gate_probability, 1);
+  gate_nhc_ = Chi2Gate(sensors_.wheel.gate_probability, 2);
+  gate_wheel_yaw_ = Chi2Gate(sensors_.wheel.gate_probability, 1);
+  gate_zupt_ = Chi2Gate(sensors_.wheel.gate_probability, 3);
   gate_zero_rate_ = Chi2Gate(kZeroRateGateProbability, 3);
-  pre_init_.SetBackwardFiller([this](const BackwardSpan& span) { return FillBackward(options_, span); });
+  pre_init_.SetBackwardFiller([this](const BackwardSpan& span) {
+    return FillBackward(sensors_, eskf_options_, standstill_options_, span);
+  });
 }
 
 Eskf::~Eskf() = default;
@@ -75,8 +84,8 @@ void Eskf::Initialize(const InitResult& init) {
   watchdog_.Clear();
   initialized_ = true;
   if (on_rts_) {
-    rts_ = std::make_unique<EskfRts>(BridgeNoise{options_.imu.gyro_noise_density, options_.imu.acc_noise_density},
-                                     options_.eskf.estimate_gravity);
+    rts_ = std::make_unique<EskfRts>(BridgeNoise{sensors_.imu.gyro_noise_density, sensors_.imu.acc_noise_density},
+                                     eskf_options_.estimate_gravity);
     rts_->StartChain(Nominal(), P_);
   }
   if (on_state_) on_state_(Estimate());
@@ -97,7 +106,7 @@ void Eskf::Propagate(double t, const ImuSample* held) {
   const Vec3 acc =
       gap ? Vec3(nom_.x.q_wb.conjugate() * (2.0 * rate_w.cross(nom_.x.v_w) - g_w)) : Vec3(held->acc - nom_.x.ba);
   // The covariance steps per sample, or over intervals of several (FlushCovariance), never across a gap.
-  const bool per_sample = gap || options_.eskf.covariance_interval <= 0.0;
+  const bool per_sample = gap || eskf_options_.covariance_interval <= 0.0;
   if (gap) FlushCovariance();
   Kinematics k{nom_.x.q_wb, nom_.x.v_w, nom_.x.p_wb};
   if (!per_sample && pending_.steps == 0) {
@@ -135,7 +144,7 @@ void Eskf::Propagate(double t, const ImuSample* held) {
     pending_.acc_dt += acc * dt;
     pending_.dt += dt;
     ++pending_.steps;
-    if (pending_.dt >= options_.eskf.covariance_interval - 1e-9) FlushCovariance();
+    if (pending_.dt >= eskf_options_.covariance_interval - 1e-9) FlushCovariance();
   }
 }
 
@@ -186,10 +195,10 @@ void Eskf::PropagateCovariance(const ImuStepJacobians& J, double dt) {
   // the run's covariance cost), and the passive rows of blocks not estimated are zero and stay zero.
   constexpr int kA = eskf::kKinematicDim, kD = eskf::kDrivingDim, kP = eskf::kNonKinematicDim - kD;
   using MatAA = Eigen::Matrix<double, kA, kA>;
-  const bool with_g = options_.eskf.estimate_gravity;
+  const bool with_g = eskf_options_.estimate_gravity;
   const Eigen::Matrix<double, kD, kA> Mt_driving =
       MulAT<kD>(J, P_.block<kD, kA>(kA, 0)) + MulBGT<kD>(J, P_.block<kD, kD>(kA, kA), with_g);
-  if (PassiveEstimated(options_)) {
+  if (PassiveEstimated(sensors_)) {
     const Eigen::Matrix<double, kP, kA> Mt_passive =
         MulAT<kP>(J, P_.block<kP, kA>(kA + kD, 0)) + MulBGT<kP>(J, P_.block<kP, kD>(kA + kD, kA), with_g);
     P_.block<kA, kP>(0, kA + kD) = Mt_passive.transpose();
@@ -202,34 +211,34 @@ void Eskf::PropagateCovariance(const ImuStepJacobians& J, double dt) {
   P_.topLeftCorner<kA, kA>() = MulAT<kA>(J, M1) + MulBGT<kA>(J, P_.block<kA, kD>(0, kA), with_g);
 
   // Process noise: sensor white noise through B, bias and scale random walks.
-  const Mat6 Qn = ImuDiscreteNoise(options_.imu.gyro_noise_density, options_.imu.acc_noise_density, dt);
+  const Mat6 Qn = ImuDiscreteNoise(sensors_.imu.gyro_noise_density, sensors_.imu.acc_noise_density, dt);
   AddDrivingNoise(J, Qn.diagonal(), P_.topLeftCorner<kA, kA>());
   AddRandomWalks(dt);
 }
 
 void Eskf::SetAdditivePriors() {
   // A block not estimated keeps a zero variance: no update moves it (its gain row is zero).
-  if (options_.eskf.estimate_gravity) {
-    BlockOf<Block::kG>(P_).diagonal().setConstant(options_.eskf.gravity_sigma * options_.eskf.gravity_sigma);
+  if (eskf_options_.estimate_gravity) {
+    BlockOf<Block::kG>(P_).diagonal().setConstant(eskf_options_.gravity_sigma * eskf_options_.gravity_sigma);
   }
-  if (OdometerScaleEstimated(options_)) {
-    P_(eskf::kS, eskf::kS) = options_.wheel.scale_sigma * options_.wheel.scale_sigma;
+  if (OdometerScaleEstimated(sensors_)) {
+    P_(eskf::kS, eskf::kS) = sensors_.wheel.scale_sigma * sensors_.wheel.scale_sigma;
   }
-  if (options_.gnss.estimate_time_offset) {
-    P_(kTd, kTd) = options_.gnss.time_offset_sigma * options_.gnss.time_offset_sigma;
+  if (sensors_.gnss.estimate_time_offset) {
+    P_(kTd, kTd) = sensors_.gnss.time_offset_sigma * sensors_.gnss.time_offset_sigma;
   }
 }
 
 void Eskf::AddRandomWalks(double dt) {
-  const double qbg = options_.imu.gyro_bias_rw * options_.imu.gyro_bias_rw * dt;
-  const double qba = options_.imu.acc_bias_rw * options_.imu.acc_bias_rw * dt;
+  const double qbg = sensors_.imu.gyro_bias_rw * sensors_.imu.gyro_bias_rw * dt;
+  const double qba = sensors_.imu.acc_bias_rw * sensors_.imu.acc_bias_rw * dt;
   BlockOf<Block::kBg>(P_).diagonal().array() += qbg;
   BlockOf<Block::kBa>(P_).diagonal().array() += qba;
-  if (OdometerScaleEstimated(options_)) {
-    P_(eskf::kS, eskf::kS) += options_.wheel.scale_rw * options_.wheel.scale_rw * dt;
+  if (OdometerScaleEstimated(sensors_)) {
+    P_(eskf::kS, eskf::kS) += sensors_.wheel.scale_rw * sensors_.wheel.scale_rw * dt;
   }
-  if (options_.gnss.estimate_time_offset) {
-    P_(kTd, kTd) += options_.gnss.time_offset_rw * options_.gnss.time_offset_rw * dt;
+  if (sensors_.gnss.estimate_time_offset) {
+    P_(kTd, kTd) += sensors_.gnss.time_offset_rw * sensors_.gnss.time_offset_rw * dt;
   }
 }
 
@@ -248,7 +257,7 @@ void Eskf::AddImu(const ImuSample& imu) {
   wheel_gyro_sum_ += imu.gyro;
   ++wheel_gyro_count_;
   // The vehicle's own constraint, at its own rate, wheels or not.
-  if (options_.vehicle.nonholonomic && imu.t - last_nhc_t_ >= 1.0 / options_.vehicle.nhc_rate - 1e-9) {
+  if (sensors_.vehicle.nonholonomic && imu.t - last_nhc_t_ >= 1.0 / sensors_.vehicle.nhc_rate - 1e-9) {
     last_nhc_t_ = imu.t;
     UpdateNonHolonomic(imu.t);
   }
@@ -300,7 +309,7 @@ bool Eskf::Update(const Model<M>& model, const Eigen::Matrix<double, M, M>& R, d
     nom_.PlusInPlace(e);
     // Converged when the step is below 1 % of the σ of every state.
     const bool small = (e.array().abs() <= 0.01 * Pi.diagonal().array().sqrt()).all();
-    if (it >= options_.eskf.iterations || small) break;
+    if (it >= eskf_options_.iterations || small) break;
     lin = model();
     const VecP delta = nom_.Minus(x0);
     const Mat3 Jr = RightJacobian(Vec3(eskf::SegmentOf<Block::kTheta>(delta)));
@@ -359,16 +368,16 @@ void Eskf::ResetFromGnss(const GnssMeasurement& m, const std::string& reason) {
   if (rts_) rts_->AfterUpdates(Nominal(), P_);  // the chain before the re-initialisation ends here
   const bool finite = nom_.x.AllFinite() && P_.allFinite();
   if (!finite) {
-    nom_.x.q_wb = FallbackAttitude(m, options_.gnss);
+    nom_.x.q_wb = FallbackAttitude(m, sensors_.gnss);
     nom_.x.bg.setZero();
     nom_.x.ba.setZero();
     nom_.x.v_w.setZero();
     nom_.ResetNonFinite();
     P_.setZero();
-    P_.topLeftCorner<nav::kDim, nav::kDim>() = FallbackCovariance(options_.imu);
+    P_.topLeftCorner<nav::kDim, nav::kDim>() = FallbackCovariance(sensors_.imu);
     SetAdditivePriors();
   }
-  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, options_.watchdog, &nom_.x, P_, course_wait_.Take());
+  const FixReset how = ResetPositionFromFix(m, prev_fix_, sensors_, watchdog_options_, &nom_.x, P_, course_wait_.Take());
   phase_epoch_.valid = false;  // the position jumped: no displacement to difference across
   P_ = 0.5 * (P_ + P_.transpose());
   gyro_sum_.setZero();
@@ -409,7 +418,7 @@ nlohmann::json Eskf::Stats() const {
   j["final_odom_scale"] = nom_.Scalar<Block::kS>();
   // The GNSS time offset: the stated value plus the estimated part (gnss.time_offset_s).
   j["time_offset"] =
-      TimeOffsetJson(options_.gnss, nom_.Scalar<Block::kTd>(), std::sqrt(std::max(P_(kTd, kTd), 0.0)));
+      TimeOffsetJson(sensors_.gnss, nom_.Scalar<Block::kTd>(), std::sqrt(std::max(P_(kTd, kTd), 0.0)));
   const Vec3 g_w = gravity();
   j["final_gravity"] = {g_w.x(), g_w.y(), g_w.z()};
   j["final_gyro_bias_deg_h"] = {nom_.x.bg.x() * kRadToDeg * 3600, nom_.x.bg.y() * kRadToDeg * 3600,

@@ -47,8 +47,10 @@ class Eskf : public Estimator {
   using MatP = Eigen::Matrix<double, eskf::kDim, eskf::kDim>;
   using VecP = Eigen::Matrix<double, eskf::kDim, 1>;
 
+  // The sections it reads: the sensors, eskf.*, standstill.* (its updates) and watchdog.*.
   // on_rts (optional): the Rauch-Tung-Striebel smoothed stream (solver/eskf_rts.h), emitted at Finish.
-  Eskf(const EstimatorOptions& options, StateCallback on_state, StateCallback on_rts = nullptr);
+  Eskf(const SensorOptions& sensors, const EskfOptions& eskf, const StandstillOptions& standstill,
+       const WatchdogOptions& watchdog, StateCallback on_state, StateCallback on_rts = nullptr);
   ~Eskf() override;
 
   std::string name() const override { return "eskf"; }
@@ -78,7 +80,7 @@ class Eskf : public Estimator {
 
  private:
   // Whether t lies beyond an IMU gap from the newest sample (imu.max_gap_s): there the state coasts.
-  bool PastImuGap(double t) const { return t - last_sample_t_ > options_.imu.max_gap; }
+  bool PastImuGap(double t) const { return t - last_sample_t_ > sensors_.imu.max_gap; }
   // Propagates nominal state and covariance to time t with the given rate and specific force held
   // (default: the last IMU sample).
   void Propagate(double t, const ImuSample* held = nullptr);
@@ -134,10 +136,13 @@ class Eskf : public Estimator {
 
   const EskfNominal& Nominal() const { return nom_; }
 
-  EstimatorOptions options_;
+  SensorOptions sensors_;
+  EskfOptions eskf_options_;
+  StandstillOptions standstill_options_;
+  WatchdogOptions watchdog_options_;
   StateCallback on_state_;
   StateCallback on_rts_;
-  PreInitOutput pre_init_{BridgeNoise{options_.imu.gyro_noise_density, options_.imu.acc_noise_density}};
+  PreInitOutput pre_init_{BridgeNoise{sensors_.imu.gyro_noise_density, sensors_.imu.acc_noise_density}};
   std::unique_ptr<EskfRts> rts_;  // with on_rts_
   bool initialized_ = false;
   EskfNominal nom_;  // the nominal state: nom_.x the NavState, then δg, the odometer scale, td (eskf_state.h)

@@ -40,11 +40,11 @@ ShiftedKinematics<T> ShiftedState(const NavState& x, double td, const Vec3& a_w,
 void Eskf::Use(const GnssMeasurement& m) {
   if (!initialized_ || m.t < nom_.x.t) return;
   Propagate(m.t);
-  if (options_.watchdog.enabled) {
+  if (watchdog_options_.enabled) {
     FlushCovariance();
     const bool finite = nom_.AllFinite() && P_.allFinite();
     const double sigma_p = std::sqrt(BlockOf<Block::kP>(P_).diagonal().maxCoeff());
-    const FixVerdict verdict = WatchdogVerdict(m, finite, sigma_p, options_, options_.watchdog, nom_.x, P_, &course_wait_, &prev_fix_);
+    const FixVerdict verdict = WatchdogVerdict(m, finite, sigma_p, sensors_, watchdog_options_, nom_.x, P_, &course_wait_, &prev_fix_);
     if (verdict != FixVerdict::kUse) {
       if (verdict == FixVerdict::kReset) {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
@@ -58,7 +58,7 @@ void Eskf::Use(const GnssMeasurement& m) {
   const bool reset = WatchGnss(m, accepted);
   prev_fix_ = m;
   if (reset) return;
-  if (m.heading_valid && options_.gnss.use_heading) UpdateHeading(m);
+  if (m.heading_valid && sensors_.gnss.use_heading) UpdateHeading(m);
 }
 
 bool Eskf::UpdateGnssPosition(const GnssMeasurement& m) {
@@ -72,7 +72,7 @@ bool Eskf::UpdateGnssPosition(const GnssMeasurement& m) {
           const ShiftedKinematics<T> k =
               ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, d.template head<3>(),
                               d.template segment<3>(3), d.template segment<3>(6), d[9]);
-          return GnssPositionModel::Residual<T>(k.p_wb, k.q_wb, options_.gnss.lever_b, m.p_w);
+          return GnssPositionModel::Residual<T>(k.p_wb, k.q_wb, sensors_.gnss.lever_b, m.p_w);
         },
         &r, &H);
     if (PastImuGap(nom_.x.t)) H.rightCols<1>().setZero();  // a coast says nothing of the offset
@@ -106,7 +106,7 @@ void Eskf::UpdateHeading(const GnssMeasurement& m) {
           const Eigen::Matrix<T, 3, 1> zero = Eigen::Matrix<T, 3, 1>::Zero();
           const ShiftedKinematics<T> k =
               ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, zero, d.template head<3>(), zero, d[3]);
-          return Eigen::Matrix<T, 1, 1>(HeadingModel::Residual<T>(k.q_wb, options_.gnss.mount_yaw, m.yaw_G));
+          return Eigen::Matrix<T, 1, 1>(HeadingModel::Residual<T>(k.q_wb, sensors_.gnss.mount_yaw, m.yaw_G));
         },
         &r, &H);
     if (PastImuGap(nom_.x.t)) H.rightCols<1>().setZero();  // a coast says nothing of the offset
@@ -129,7 +129,7 @@ void Eskf::Use(const GnssVelocityMeasurement& m) {
           const ShiftedKinematics<T> k =
               ShiftedState<T>(nom_.x, nom_.Scalar<Block::kTd>(), a_w_, omega_b, Eigen::Matrix<T, 3, 1>::Zero(),
                               d.template segment<3>(3), d.template head<3>(), d[6]);
-          return GnssVelocityModel::Residual<T>(k.q_wb, k.v_w, omega_b, options_.gnss.lever_b, m.v_w);
+          return GnssVelocityModel::Residual<T>(k.q_wb, k.v_w, omega_b, sensors_.gnss.lever_b, m.v_w);
         },
         &r, &H);
     if (PastImuGap(nom_.x.t)) H.rightCols<1>().setZero();  // a coast says nothing of the offset
@@ -141,7 +141,7 @@ void Eskf::Use(const GnssVelocityMeasurement& m) {
 }
 
 void Eskf::Use(const WheelMeasurement& m) {
-  if (!initialized_ || m.t < nom_.x.t || !options_.wheel.enabled) return;
+  if (!initialized_ || m.t < nom_.x.t || !sensors_.wheel.enabled) return;
   Propagate(m.t);
   // At zero pulses this is a zero-speed measurement; the standstill updates (StandstillMeasurement) come from the
   // session's detector, which also wants the IMU quiet.
@@ -167,10 +167,10 @@ void Eskf::UpdateWheelSpeed(const WheelMeasurement& m) {
           const T s = T(s0) + d[6];
           return Eigen::Matrix<T, 1, 1>(AxleSpeedModel::Residual<T>(
               Rotated<T>(nom_.x, Eigen::Matrix<T, 3, 1>(d.template segment<3>(3))), v, s, omega_b,
-              options_.wheel.lever_b, m.speed));
+              sensors_.wheel.lever_b, m.speed));
         },
         &r, &H7);
-    if (!options_.wheel.estimate_scale) H7(0, 6) = 0.0;  // a scale held fixed takes no correction
+    if (!sensors_.wheel.estimate_scale) H7(0, 6) = 0.0;  // a scale held fixed takes no correction
     return Linearized<1>{r, EmbedJacobian<1>({{Block::kV, H7.leftCols<3>()},
                                               {Block::kTheta, H7.middleCols<3>(3)},
                                               {Block::kS, H7.rightCols<1>()}})};
@@ -187,11 +187,11 @@ void Eskf::UpdateWheelYawRate(const WheelMeasurement& m) {
     const double omega_z = (mean_gyro - nom_.x.bg - nom_.x.q_wb.conjugate() * earth_.rate_w()).z();
     Eigen::Matrix<double, 1, eskf::kDim> H = Eigen::Matrix<double, 1, eskf::kDim>::Zero();
     H(0, eskf::Offset(Block::kBg) + 2) = -nom_.Scalar<Block::kS>();
-    if (options_.wheel.estimate_scale) H(0, eskf::kS) = omega_z;
+    if (sensors_.wheel.estimate_scale) H(0, eskf::kS) = omega_z;
     return Linearized<1>{Eigen::Matrix<double, 1, 1>(nom_.Scalar<Block::kS>() * omega_z - m.yaw_rate), H};
   };
   // The gyro's own noise over the interval adds to the wheels'.
-  const double gyro_var = std::pow(options_.imu.gyro_noise_density, 2) / m.interval;
+  const double gyro_var = std::pow(sensors_.imu.gyro_noise_density, 2) / m.interval;
   const double var =
       m.yaw_rate_sigma * m.yaw_rate_sigma + nom_.Scalar<Block::kS>() * nom_.Scalar<Block::kS>() * gyro_var;
   Update<1>(model, Eigen::Matrix<double, 1, 1>(var), gate_wheel_yaw_, &wheel_yaw_counts_, m.t);
@@ -207,12 +207,12 @@ void Eskf::UpdateNonHolonomic(double t) {
           using T = typename std::decay_t<decltype(d)>::Scalar;
           const Eigen::Matrix<T, 3, 1> v = nom_.x.v_w.cast<T>() + d.template head<3>();
           return AxleNhcModel::Residual<T>(Rotated<T>(nom_.x, Eigen::Matrix<T, 3, 1>(d.template tail<3>())), v, omega_b,
-                                           options_.wheel.lever_b);
+                                           sensors_.wheel.lever_b);
         },
         &r, &H6);
     return Linearized<2>{r, EmbedJacobian<2>({{Block::kV, H6.leftCols<3>()}, {Block::kTheta, H6.rightCols<3>()}})};
   };
-  const double s2 = options_.vehicle.nhc_sigma * options_.vehicle.nhc_sigma;
+  const double s2 = sensors_.vehicle.nhc_sigma * sensors_.vehicle.nhc_sigma;
   Update<2>(model, Eigen::Matrix2d::Identity() * s2, gate_nhc_, &nhc_counts_, t);
 }
 
@@ -226,7 +226,7 @@ void Eskf::Use(const StandstillMeasurement& m) {
   gyro_sum_.setZero();
   gyro_count_ = 0;
   gyro_sum_start_ = m.t;
-  if (!StandstillPlausible(nom_.x.v_w, options_.standstill)) {
+  if (!StandstillPlausible(nom_.x.v_w, standstill_options_)) {
     zupt_counts_.Reject("moving", m.t);  // a quiet IMU at speed: not a stop
     return;
   }
@@ -235,18 +235,18 @@ void Eskf::Use(const StandstillMeasurement& m) {
     const double sigma_tilt = e.sigma_att.head<2>().maxCoeff();
     const double sigma_ba = std::sqrt(BlockOf<Block::kBa>(P_).diagonal().maxCoeff());
     if (AcceleratingWithoutWitness(m, nom_.x, earth_.Gravity(nom_.x.p_wb) + nom_.Get<Block::kG>(), sigma_tilt, sigma_ba,
-                                   options_.imu.acc_noise_density)) {
+                                   sensors_.imu.acc_noise_density)) {
       zupt_counts_.Reject("accelerating", m.t);  // braking smoothly, nothing to say it stopped
       return;
     }
   }
   // Standing: zero velocity, and the gyro reads its bias (zero-rate update), so nothing wanders.
-  const double sv = options_.standstill.velocity_sigma;
+  const double sv = standstill_options_.velocity_sigma;
   Update<3>([&] { return Linearized<3>{nom_.x.v_w, EmbedJacobian<3>({{Block::kV, Mat3::Identity()}})}; },
             Mat3::Identity() * sv * sv, gate_zupt_, &zupt_counts_, m.t);
   if (rate_usable) {
     // Standing on the rotating Earth, the gyro reads its bias plus the Earth rate.
-    const double sigma = ZeroRateSigma(options_.imu.gyro_noise_density, T);
+    const double sigma = ZeroRateSigma(sensors_.imu.gyro_noise_density, T);
     Update<3>(
         [&] {
           return Linearized<3>{Vec3(nom_.x.bg + nom_.x.q_wb.conjugate() * earth_.rate_w() - mean_gyro),

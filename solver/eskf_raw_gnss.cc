@@ -92,7 +92,7 @@ void Eskf::Use(const RawGnssMeasurement& m) {
   Propagate(m.t);
   FlushCovariance();
   const Vec3 omega_b = BodyRate();
-  const Antenna a = AntennaAt(nom_.x, options_.gnss.lever_b, omega_b, m);
+  const Antenna a = AntennaAt(nom_.x, sensors_.gnss.lever_b, omega_b, m);
   size_t skipped = 0;
   const std::vector<RawSatellite> sats = PrepareSatellites(m, a.r_ecef, &skipped);
   ++raw_.epochs;
@@ -104,7 +104,7 @@ void Eskf::Use(const RawGnssMeasurement& m) {
 
 void Eskf::UpdateRawGnss(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats, bool rates) {
   const Vec3 omega_b = BodyRate();
-  const Vec3& lever_b = options_.gnss.lever_b;
+  const Vec3& lever_b = sensors_.gnss.lever_b;
   std::vector<const RawSatellite*> in;
   for (const RawSatellite& s : sats) {
     if (!rates || s.has_rate) in.push_back(&s);
@@ -130,7 +130,7 @@ void Eskf::UpdateRawGnss(const RawGnssMeasurement& m, const std::vector<RawSatel
     DifferenceByGroup(rows_at(nom_.x, kept), &r, &H, &R);
     return Linearized<Eigen::Dynamic>{r, H};
   };
-  if (Update<Eigen::Dynamic>(model, R_d, Chi2Gate(options_.gnss.gate_probability, dof), &counts, m.t)) {
+  if (Update<Eigen::Dynamic>(model, R_d, Chi2Gate(sensors_.gnss.gate_probability, dof), &counts, m.t)) {
     raw_.satellites_used += kept.size();
   }
 }
@@ -163,7 +163,7 @@ constexpr double kMaxPhaseInterval = 2.0;  // s: a longer gap between epochs end
 // interval, δv̇ = −R[f]×δθ − R·δba). The receiver clock's change is one for every satellite: one group.
 void Eskf::UpdateRawPhase(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats) {
   const double dt = m.t - phase_epoch_.t;
-  const Vec3& lever_b = options_.gnss.lever_b;
+  const Vec3& lever_b = sensors_.gnss.lever_b;
   if (phase_epoch_.valid && dt > 0.0 && dt <= kMaxPhaseInterval) {
     const EskfNominal x0 = nom_;
     const Mat3 R0 = x0.x.R_wb();
@@ -237,7 +237,7 @@ void Eskf::UpdateRawPhase(const RawGnssMeasurement& m, const std::vector<RawSate
           DifferenceByGroup(rows_at(nom_), &r, &H, &R);
           return Linearized<Eigen::Dynamic>{r, H};
         };
-        Update<Eigen::Dynamic>(model, R_d, Chi2Gate(options_.gnss.gate_probability, static_cast<int>(r_d.size())),
+        Update<Eigen::Dynamic>(model, R_d, Chi2Gate(sensors_.gnss.gate_probability, static_cast<int>(r_d.size())),
                                &raw_.phases, m.t);
       }
     }

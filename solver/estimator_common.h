@@ -15,6 +15,7 @@
 
 #include "core/measurements.h"
 #include "core/nav_state.h"
+#include "core/standstill_detector.h"
 #include "solver/estimator_options.h"
 
 namespace gins {

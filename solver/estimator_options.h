@@ -1,11 +1,11 @@
-// The estimators' options: the sensors and the initialisation (core), the standstill detector, and each
-// estimator's own settings. config/ fills them from YAML; the estimators and the session take them.
+// The estimators' own sections of the options (eskf.*, smoother.*, batch.*, watchdog.*); the sensors', the
+// initialisation's and the standstill detector's are declared in core/. config/ fills them from YAML; each
+// estimator takes the sections it reads.
 #pragma once
 
 #include <string>
 
-#include "core/standstill_detector.h"
-#include "core/initializer.h"
+#include "core/sensors.h"
 
 namespace gins {
 
@@ -44,15 +44,6 @@ struct WatchdogOptions {
   bool enabled = true;                // watchdog.enabled
   double max_reject = 15.0;           // watchdog.max_reject_s: every GNSS fix rejected for this long
   double max_position_sigma = 100.0;  // watchdog.max_position_sigma_m: position 1-σ that counts as exploded
-};
-
-// Everything an estimator (and the session that feeds it) may read (the standstill detector's options come
-// with the initialiser's).
-struct EstimatorOptions : InitializerOptions {
-  EskfOptions eskf;
-  SmootherOptions smoother;
-  BatchOptions batch;
-  WatchdogOptions watchdog;
 };
 
 // The odometer scale is a state (the ESKF's δs, the keyframes' scale block) only with wheels and

@@ -21,8 +21,10 @@ namespace {
 constexpr size_t kMaxPending = 100000;
 }  // namespace
 
-EstimatorPipeline::EstimatorPipeline(const EstimatorOptions& options) : options_(options) {
-  if (options_.gnss.origin) frame_.emplace(*options_.gnss.origin);
+EstimatorPipeline::EstimatorPipeline(const SensorOptions& sensors, const InitOptions& init,
+                                     const StandstillOptions& standstill)
+    : sensors_(sensors), init_options_(init), standstill_options_(standstill) {
+  if (sensors_.gnss.origin) frame_.emplace(*sensors_.gnss.origin);
 }
 
 void EstimatorPipeline::AddEstimator(std::unique_ptr<Estimator> estimator) {
@@ -145,18 +147,16 @@ void EstimatorPipeline::Touch(double t) {
 
 void EstimatorPipeline::EnsureInitializer() {
   if (init_ || !frame_) return;
-  earth_ = EarthModel::FromOptions(*frame_, options_.gravity);
+  earth_ = EarthModel::FromOptions(*frame_, sensors_.gravity);
   g_norm_ = earth_.g_norm();
+  InitOptions init = init_options_;
   if (raw_feed_ || raw_.epochs > 0) {
     // Raw GNSS: the Dopplers and carrier phases pin the yaw within seconds of the start, while single-point
     // fixes would hold a 1° acceptance for a minute (docs/estimators.md, "Tightly coupled GNSS").
-    EstimatorOptions o = options_;
-    o.init.max_attitude_sigma = std::max(o.init.max_attitude_sigma, o.gnss.raw.init_max_attitude_sigma);
-    init_ = std::make_unique<Initializer>(o, earth_);
-  } else {
-    init_ = std::make_unique<Initializer>(options_, earth_);
+    init.max_attitude_sigma = std::max(init.max_attitude_sigma, sensors_.gnss.raw.init_max_attitude_sigma);
   }
-  standstill_ = std::make_unique<StandstillDetector>(options_.standstill, g_norm_, options_.wheel.interval);
+  init_ = std::make_unique<Initializer>(sensors_, init, standstill_options_, earth_);
+  standstill_ = std::make_unique<StandstillDetector>(standstill_options_, g_norm_, sensors_.wheel.interval);
   // Replay what arrived before the world frame existed, in time order.
   size_t i = 0, j = 0;
   while (i < pending_imu_.size() || j < pending_wheel_.size()) {
@@ -180,7 +180,7 @@ void EstimatorPipeline::WatchImuInterval(double t) {
     ++imu_same_stamp_;
     return;
   }
-  if (dt > options_.imu.max_gap) return;  // a gap: the estimators count it
+  if (dt > sensors_.imu.max_gap) return;  // a gap: the estimators count it
   const auto near = [](double a, double b) { return std::abs(a - b) <= 0.1 * b; };
   if (imu_nominal_dt_ <= 0.0 || near(dt, imu_nominal_dt_)) {
     if (imu_nominal_dt_ <= 0.0) imu_nominal_dt_ = dt;
@@ -206,10 +206,10 @@ void EstimatorPipeline::AddImu(const ImuSample& raw) {
   Touch(raw.t);
   WatchImuInterval(raw.t);
   ImuSample s = raw;
-  s.gyro = options_.imu.R_b_imu * raw.gyro;
-  s.acc = options_.imu.R_b_imu * raw.acc;
+  s.gyro = sensors_.imu.R_b_imu * raw.gyro;
+  s.acc = sensors_.imu.R_b_imu * raw.acc;
   imu_check_.Add(s.acc);
-  switch (imu_check_.Judge(options_.vehicle.nonholonomic)) {
+  switch (imu_check_.Judge(sensors_.vehicle.nonholonomic)) {
     case ImuAxesAndUnitsCheck::Outcome::kRefuse:
       throw RunError(imu_check_.message());
     case ImuAxesAndUnitsCheck::Outcome::kWarn:
@@ -221,7 +221,7 @@ void EstimatorPipeline::AddImu(const ImuSample& raw) {
     default:
       break;
   }
-  if (options_.vehicle.nonholonomic) {
+  if (sensors_.vehicle.nonholonomic) {
     turn_check_.AddImu(s.t, s.gyro, s.acc);
     clock_check_.AddImu(s.t, s.acc);
   }
@@ -283,7 +283,7 @@ void EstimatorPipeline::DetectStandstill(double t) {
     return;
   }
   // The detector looked back over its window: the vehicle has stood at least that long.
-  if (standing_since_ < 0.0) standing_since_ = t - options_.standstill.window;
+  if (standing_since_ < 0.0) standing_since_ = t - standstill_options_.window;
   if (t - last_standstill_sent_ < kInterval - 1e-9) return;
   last_standstill_sent_ = t;
   ++standstill_sent_;
@@ -291,7 +291,7 @@ void EstimatorPipeline::DetectStandstill(double t) {
   if (standstill_->Decide() == StandstillDetector::State::kQuietUnwitnessed) {
     m.witnessed = false;
     m.acc_mean_b = standstill_->WindowMeanAcc();
-    m.window_s = options_.standstill.window;
+    m.window_s = standstill_options_.window;
   }
   Dispatch(&Estimator::Add, Measurement(m));
 }
@@ -299,7 +299,7 @@ void EstimatorPipeline::DetectStandstill(double t) {
 void EstimatorPipeline::AddWheel(const WheelRecord& o) {
   DrainRawGnss(o.t);
   Touch(o.t);
-  if (!options_.wheel.enabled) {
+  if (!sensors_.wheel.enabled) {
     ++odom_ignored_;
     return;
   }
@@ -320,7 +320,7 @@ void EstimatorPipeline::AddWheel(const WheelRecord& o) {
 }
 
 WheelMeasurement EstimatorPipeline::WheelFromOdom(const WheelRecord& o) {
-  const WheelOptions& wo = options_.wheel;
+  const WheelOptions& wo = sensors_.wheel;
   // The pulses were counted since the previous record: its spacing is the interval, within half the
   // nominal one either way (clock jitter, counted); a longer spacing means records were lost, and the
   // record's own count then covers the nominal interval only (a gap, counted).
@@ -368,25 +368,25 @@ void EstimatorPipeline::UseFix(const GnssRecord& g, const RawGnssMeasurement* ra
   m.t = g.t;
   m.p_w = frame_->ToEnu({g.lat_deg, g.lon_deg, g.alt_m});
   // A logged σ is trusted down to a floor: a zero σ would make the fix infinitely certain.
-  m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options_.gnss.min_sigma) : options_.gnss.sigma_enu;
+  m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(sensors_.gnss.min_sigma) : sensors_.gnss.sigma_enu;
   // Successive fixes repeat much the same error: each is worth less than an independent one.
   const double since_fix = last_fix_t_ ? g.t - *last_fix_t_ : std::numeric_limits<double>::infinity();
   last_fix_t_ = g.t;
-  m.sigma_w *= CorrelatedNoiseInflation(since_fix, options_.gnss.error_correlation);
+  m.sigma_w *= CorrelatedNoiseInflation(since_fix, sensors_.gnss.error_correlation);
   m.heading_valid = g.heading_valid;
   // The receiver's heading is against true north at the antenna; w's north is the origin's.
   m.yaw_G = g.heading_valid ? LocalYawToWorld(*frame_, *last_fix_geo_, CompassDegToEnuYaw(g.heading_deg))
                             : CompassDegToEnuYaw(g.heading_deg);
-  m.sigma_yaw = options_.gnss.heading_sigma;
+  m.sigma_yaw = sensors_.gnss.heading_sigma;
   if (standstill_) standstill_->AddGnss(m);
-  if (options_.vehicle.nonholonomic) {
+  if (sensors_.vehicle.nonholonomic) {
     const double sigma_h = m.sigma_w.head<2>().norm() / std::sqrt(2.0);
     turn_check_.AddFix(m.t, m.p_w, sigma_h);
     if (turn_check_.outcome() == TurnRateCheck::Outcome::kRefuse) throw RunError(turn_check_.message());
     clock_check_.AddFix(m.t, m.p_w, sigma_h);
     if (clock_check_.outcome() == ClockOffsetCheck::Outcome::kRefuse) throw RunError(clock_check_.message());
-    if (g.heading_valid && options_.gnss.use_heading) {
-      heading_check_.AddFix(m.t, m.p_w, sigma_h, g.heading_deg, options_.gnss.mount_yaw);
+    if (g.heading_valid && sensors_.gnss.use_heading) {
+      heading_check_.AddFix(m.t, m.p_w, sigma_h, g.heading_deg, sensors_.gnss.mount_yaw);
       if (heading_check_.outcome() == HeadingCourseCheck::Outcome::kRefuse) throw RunError(heading_check_.message());
     }
   }
@@ -413,14 +413,14 @@ void EstimatorPipeline::AddGnssVelocity(const GnssVelocityRecord& g) {
   DrainRawGnss(g.t);
   Touch(g.t);
   const bool in_outage = initialized_ && !outage_schedule_.empty() && outage_schedule_.Contains(g.t, first_t_);
-  if (!options_.gnss.use_velocity || !last_fix_geo_ || !init_ || in_outage) {
+  if (!sensors_.gnss.use_velocity || !last_fix_geo_ || !init_ || in_outage) {
     ++gvel_unused_;
     return;
   }
   GnssVelocityMeasurement m;
   m.t = g.t;
   m.v_w = frame_->RotationFromLocalEnu(*last_fix_geo_) * g.v_enu;
-  m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options_.gnss.min_velocity_sigma) : options_.gnss.velocity_sigma_enu;
+  m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(sensors_.gnss.min_velocity_sigma) : sensors_.gnss.velocity_sigma_enu;
   if (standstill_) standstill_->AddGnssVelocity(m);
   if (!initialized_) {
     init_->AddGnssVelocity(m);

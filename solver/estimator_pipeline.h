@@ -23,10 +23,10 @@
 #include "core/eval/gnss_outages.h"
 #include "core/io/log_record.h"
 #include "core/measurements.h"
+#include "core/sensors.h"
 #include "core/standstill_detector.h"
 #include "core/initializer.h"
 #include "solver/estimator.h"
-#include "solver/estimator_options.h"
 #include "solver/raw_gnss_feed.h"
 
 namespace gins {
@@ -39,7 +39,9 @@ class RunError : public std::runtime_error {
 
 class EstimatorPipeline {
  public:
-  explicit EstimatorPipeline(const EstimatorOptions& options);
+  // The sensors, and the initialisation's and the standstill detector's settings (the estimators take
+  // their own sections).
+  EstimatorPipeline(const SensorOptions& sensors, const InitOptions& init, const StandstillOptions& standstill);
   ~EstimatorPipeline();
 
   void AddEstimator(std::unique_ptr<Estimator> estimator);
@@ -127,7 +129,9 @@ class EstimatorPipeline {
   bool parallel_ = false;
   std::vector<std::unique_ptr<Worker>> workers_;  // estimators_[i + 1] runs on workers_[i] when parallel
 
-  EstimatorOptions options_;
+  SensorOptions sensors_;
+  InitOptions init_options_;
+  StandstillOptions standstill_options_;
   std::optional<LocalEnuFrame> frame_;
   double g_norm_ = 0.0;
   EarthModel earth_;  // once the world frame exists
@@ -196,8 +200,8 @@ class EstimatorPipeline {
   // once initialised; in-window fixes before that are kept (initialisation needs them) and counted. Gaps
   // in the log's own GNSS stream are recorded too. Both go into Stats()["gnss_outages"].
   bool DropForSimulatedOutage(double t);
-  GnssOutageSchedule outage_schedule_{options_.gnss.outages, options_.gnss.periodic_outages.first_start,
-                                      options_.gnss.periodic_outages.duration, options_.gnss.periodic_outages.period};
+  GnssOutageSchedule outage_schedule_{sensors_.gnss.outages, sensors_.gnss.periodic_outages.first_start,
+                                      sensors_.gnss.periodic_outages.duration, sensors_.gnss.periodic_outages.period};
   GnssGapTracker gnss_gaps_;
   uint64_t outage_dropped_ = 0, outage_kept_before_init_ = 0;
 };

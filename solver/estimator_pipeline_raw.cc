@@ -137,20 +137,20 @@ void EstimatorPipeline::UseRawGnss(PreparedRawGnss p) {
     const std::vector<RawSatellite> sats = PrepareSatellites(m, sol.position_ecef_m);
     Vec3 v_ecef;
     Mat3 cov;
-    if (SolveDopplerVelocity(sats, sol.position_ecef_m, std::sqrt(Chi2Gate(options_.gnss.gate_probability, 1)),
+    if (SolveDopplerVelocity(sats, sol.position_ecef_m, std::sqrt(Chi2Gate(sensors_.gnss.gate_probability, 1)),
                              &v_ecef, &cov)) {
       m.has_velocity = true;
       m.velocity.t = m.t;
       m.velocity.v_w = m.R_ecef_w.transpose() * v_ecef;
       const Mat3 cov_w = m.R_ecef_w.transpose() * cov * m.R_ecef_w;
-      m.velocity.sigma_w = cov_w.diagonal().cwiseMax(0.0).cwiseSqrt().cwiseMax(options_.gnss.min_velocity_sigma);
+      m.velocity.sigma_w = cov_w.diagonal().cwiseMax(0.0).cwiseSqrt().cwiseMax(sensors_.gnss.min_velocity_sigma);
     } else {
       ++raw_.without_velocity;
     }
   }
   if (!initialized_) ++raw_.used_before_init;
   UseFix(fix, &m);
-  if (m.has_velocity && options_.gnss.use_velocity) {
+  if (m.has_velocity && sensors_.gnss.use_velocity) {
     if (standstill_) standstill_->AddGnssVelocity(m.velocity);
     if (!initialized_ && init_) init_->AddGnssVelocity(m.velocity);
   }

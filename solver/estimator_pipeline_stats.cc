@@ -20,7 +20,7 @@ nlohmann::json EstimatorPipeline::Stats() const {
   if (raw_feed_ || raw_.epochs > 0) j["gnss_raw"] = RawGnssStats();
   j[k::kRestStatesBeforeInitialization] = rest_sent_;
   if (!imu_warning_.empty()) j["warnings"] = {imu_warning_};
-  if (options_.vehicle.nonholonomic) {
+  if (sensors_.vehicle.nonholonomic) {
     const char* verdict = turn_check_.outcome() == TurnRateCheck::Outcome::kOk ? "ok" : "undecided";
     j["turn_rate_check"] = {{"verdict", verdict},
                             {"course_per_gyro", turn_check_.slope()},
@@ -28,7 +28,7 @@ nlohmann::json EstimatorPipeline::Stats() const {
                             {"turned_deg", turn_check_.turned() * kRadToDeg}};
     j["clock_check"] = {{"verdict", clock_check_.outcome() == ClockOffsetCheck::Outcome::kOk ? "ok" : "undecided"},
                         {"correlation_at_0", clock_check_.Correlation(0)}};
-    if (options_.gnss.use_heading) {
+    if (sensors_.gnss.use_heading) {
       j["heading_check"] = {
           {"verdict", heading_check_.outcome() == HeadingCourseCheck::Outcome::kOk ? "ok" : "undecided"}};
     }

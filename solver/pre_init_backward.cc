@@ -32,7 +32,8 @@ Mat15 Reversed(const Mat15& P) {
 
 }  // namespace
 
-std::vector<StateEstimate> FillBackward(const EstimatorOptions& options, const BackwardSpan& span) {
+std::vector<StateEstimate> FillBackward(const SensorOptions& sensors, const EskfOptions& eskf_options,
+                                        const StandstillOptions& standstill, const BackwardSpan& span) {
   const double t_s = span.start.x.t;
   if (span.fixes.empty() || span.imu.empty()) return {};
   // From the first IMU sample (a fix before it would be reached only by coasting).
@@ -43,13 +44,15 @@ std::vector<StateEstimate> FillBackward(const EstimatorOptions& options, const B
   if (!fix_inside) return {};
   const auto reverse = [t_s](double t) { return 2.0 * t_s - t; };
 
-  EstimatorOptions o = options;
-  o.gnss.estimate_time_offset = false;
-  o.gnss.time_offset = 0.0;
-  o.wheel.enabled = false;
-  o.watchdog.enabled = false;  // a reset would restart the chain: the span is short and starts known
+  SensorOptions backward = sensors;
+  backward.gnss.estimate_time_offset = false;
+  backward.gnss.time_offset = 0.0;
+  backward.wheel.enabled = false;
+  WatchdogOptions no_watchdog;
+  no_watchdog.enabled = false;  // a reset would restart the chain: the span is short and starts known
   std::vector<StateEstimate> smoothed;
-  Eskf eskf(o, nullptr, [&](const StateEstimate& s) { smoothed.push_back(s); });
+  Eskf eskf(backward, eskf_options, standstill, no_watchdog, nullptr,
+            [&](const StateEstimate& s) { smoothed.push_back(s); });
   InitResult init;
   init.x0 = Reversed(span.start.x, t_s);
   init.P0 = Reversed(span.P);

@@ -16,6 +16,7 @@
 
 #include "core/earth.h"
 #include "core/measurements.h"
+#include "core/standstill_detector.h"
 #include "solver/estimator.h"
 #include "solver/estimator_options.h"
 
@@ -32,7 +33,8 @@ struct BackwardSpan {
 };
 
 // The smoothed states in [max(span.from, the first IMU sample), span.start.x.t), in time order; empty
-// without a fix there.
-std::vector<StateEstimate> FillBackward(const EstimatorOptions& options, const BackwardSpan& span);
+// without a fix there. The sections are the forward ESKF's (the backward run has no watchdog).
+std::vector<StateEstimate> FillBackward(const SensorOptions& sensors, const EskfOptions& eskf,
+                                        const StandstillOptions& standstill, const BackwardSpan& span);
 
 }  // namespace gins

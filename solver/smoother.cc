@@ -23,16 +23,21 @@ double Seconds(std::chrono::steady_clock::duration d) { return std::chrono::dura
 
 }  // namespace
 
-Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, StateCallback on_online,
-                   StateCallback on_batch)
-    : options_(options),
+Smoother::Smoother(const SensorOptions& sensors, const EskfOptions& eskf, const SmootherOptions& smoother,
+                   const BatchOptions& batch, const StandstillOptions& standstill, const WatchdogOptions& watchdog,
+                   StateCallback on_final, StateCallback on_online, StateCallback on_batch)
+    : sensors_(sensors),
+      eskf_options_(eskf),
+      smoother_options_(smoother),
+      batch_options_(batch),
+      standstill_options_(standstill),
+      watchdog_options_(watchdog),
       on_final_(std::move(on_final)),
       on_online_(std::move(on_online)),
       on_batch_(std::move(on_batch)),
       factor_log_(on_batch_ ? std::make_unique<FactorLog>() : nullptr),
-      window_(options),
+      window_(sensors),
       context_{window_,
-               options_,
                earth_,
                last_imu_,
                [this](double t) { return PredictAt(t); },
@@ -40,16 +45,18 @@ Smoother::Smoother(const EstimatorOptions& options, StateCallback on_final, Stat
                [this]() -> const MatX* { return newest_two_cov_.size() > 0 ? &newest_two_cov_ : nullptr; },
                [this](double t) { return PartialAt(t); },
                [this](double t) { return PredictStateAt(t); }},
-      watchdog_(options.watchdog) {
+      watchdog_(watchdog) {
   window_.SetLog(factor_log_.get());
-  attachers_.push_back(std::make_unique<VehicleAttacher>(options_));
+  attachers_.push_back(std::make_unique<VehicleAttacher>(sensors_));
   attachers_.push_back(
-      std::make_unique<StandstillAttacher>(options_.standstill, options_.imu, options_.wheel.gate_probability));
-  attachers_.push_back(std::make_unique<GnssVelocityAttacher>(options_.gnss));
+      std::make_unique<StandstillAttacher>(standstill_options_, sensors_.imu, sensors_.wheel.gate_probability));
+  attachers_.push_back(std::make_unique<GnssVelocityAttacher>(sensors_.gnss));
   attachers_.push_back(std::make_unique<GnssAttacher>(
-      options_.gnss, [this](double t, bool accepted) { WatchGnss(t, accepted); },
+      sensors_.gnss, [this](double t, bool accepted) { WatchGnss(t, accepted); },
       [this](double factor) { RelievePrior(factor); }));
-  pre_init_.SetBackwardFiller([this](const BackwardSpan& span) { return FillBackward(options_, span); });
+  pre_init_.SetBackwardFiller([this](const BackwardSpan& span) {
+    return FillBackward(sensors_, eskf_options_, standstill_options_, span);
+  });
 }
 
 Smoother::~Smoother() = default;
@@ -80,8 +87,8 @@ void Smoother::Initialize(const InitResult& init) {
   newest_cov_ = window_.PriorCovariance(init.P0);
   solve_pending_ = false;
 
-  preint_ = std::make_shared<Preintegration>(init.x0.bg, init.x0.ba, options_.imu.gyro_noise_density,
-                                             options_.imu.acc_noise_density);
+  preint_ = std::make_shared<Preintegration>(init.x0.bg, init.x0.ba, sensors_.imu.gyro_noise_density,
+                                             sensors_.imu.acc_noise_density);
   interval_samples_.clear();
   last_imu_.reset();
   last_sample_t_ = init.x0.t;
@@ -105,7 +112,7 @@ void Smoother::IntegrateTo(double t, const ImuSample* held) {
   // (a fix after the initialisation, before the first sample): no rotation and no acceleration, from the
   // current estimate, with the uncertainty of an unknown rate and acceleration held over the gap. So the
   // preintegration always reaches t, and no keyframe is made over an empty one.
-  if (held == nullptr || t - last_sample_t_ > options_.imu.max_gap) {
+  if (held == nullptr || t - last_sample_t_ > sensors_.imu.max_gap) {
     coast.t = t_now_;
     coast.gyro = pred_.bg + pred_.q_wb.conjugate() * earth_.rate_w();
     coast.acc = pred_.q_wb.conjugate() * (2.0 * earth_.rate_w().cross(pred_.v_w) - g_w_) + pred_.ba;
@@ -138,7 +145,7 @@ void Smoother::AddImu(const ImuSample& imu) {
   SolveIfPending();
   // Before the first sample after the initialisation, its epoch is the newest sample (a dropout right after
   // it is a gap as any other).
-  if (imu.t - last_sample_t_ > options_.imu.max_gap) imu_gaps_.Add(last_sample_t_, imu.t);
+  if (imu.t - last_sample_t_ > sensors_.imu.max_gap) imu_gaps_.Add(last_sample_t_, imu.t);
   const ImuSample mid = last_imu_ ? HeldBetween(*last_imu_, imu) : imu;
   IntegrateTo(imu.t, &mid);
   last_imu_ = imu;
@@ -146,7 +153,7 @@ void Smoother::AddImu(const ImuSample& imu) {
   // Without GNSS a keyframe still comes every max_keyframe_interval, so no preintegration spans an outage.
   // The 10 % grace lets a fix due at that very epoch (often logged just after the IMU sample) make the
   // keyframe itself, instead of a second solve at the same time.
-  if (t_now_ - window_.back().t >= 1.1 * options_.smoother.max_keyframe_interval) CreateKeyframe(t_now_);
+  if (t_now_ - window_.back().t >= 1.1 * smoother_options_.max_keyframe_interval) CreateKeyframe(t_now_);
 }
 
 void Smoother::SolveIfPending() {
@@ -162,11 +169,11 @@ Prediction Smoother::PredictAt(double t) {
   MatX cov = newest_cov_;
   if (newest.id != newest_cov_id_ && window_.size() >= 2 && newest.preint != nullptr) {
     const Keyframe& solved = window_[window_.size() - 2];
-    cov = PredictBlockCovariance(types, newest_cov_, solved.State(), *newest.preint, options_);
+    cov = PredictBlockCovariance(types, newest_cov_, solved.State(), *newest.preint, sensors_);
   }
   if (BeyondNewest(t)) {
     p.x = pred_;
-    p.cov = PredictBlockCovariance(types, cov, newest.State(), *preint_, options_);
+    p.cov = PredictBlockCovariance(types, cov, newest.State(), *preint_, sensors_);
   } else {
     p.x = newest.State();
     p.cov = cov;
@@ -187,7 +194,7 @@ Anchor Smoother::AnchorAt(double t) {
   Keyframe& newest = window_.back();
   if (std::abs(t - newest.t) <= kSameEpoch) return {&newest, nullptr};
   IntegrateTo(t);
-  if (t - newest.t >= options_.smoother.min_keyframe_interval || preint_->dt() <= 0.0) {
+  if (t - newest.t >= smoother_options_.min_keyframe_interval || preint_->dt() <= 0.0) {
     Keyframe& kf = CreateKeyframe(t);
     return {&kf, nullptr};
   }
@@ -250,8 +257,8 @@ Keyframe& Smoother::CreateKeyframe(double t) {
   kf.imu_id = AddImuFactor(prev, kf);
   kf.imu_log_index = window_.last_logged();
   window_.AddRandomWalks(prev, kf);
-  preint_ = std::make_shared<Preintegration>(pred_.bg, pred_.ba, options_.imu.gyro_noise_density,
-                                             options_.imu.acc_noise_density);
+  preint_ = std::make_shared<Preintegration>(pred_.bg, pred_.ba, sensors_.imu.gyro_noise_density,
+                                             sensors_.imu.acc_noise_density);
   interval_samples_.clear();
   ++keyframes_;
   // Every new keyframe is solved before the IMU moves on: a window left unsolved would predict the next
@@ -281,24 +288,24 @@ void Smoother::Use(const GnssVelocityMeasurement& x, const Measurement& m) {
 }
 
 void Smoother::Use(const WheelMeasurement& x, const Measurement& m) {
-  if (!initialized_ || !options_.wheel.enabled) return;
+  if (!initialized_ || !sensors_.wheel.enabled) return;
   IntegrateTo(x.t);
   Attach(m);
 }
 
 bool Smoother::Solve() {
   ceres::Solver::Options so;
-  if (options_.smoother.linear_solver == "sparse_normal_cholesky") {
+  if (smoother_options_.linear_solver == "sparse_normal_cholesky") {
     auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
     int group = 0;
     for (double* b : window_.EstimatedBlocks()) ordering->AddElementToGroup(b, group++);
-    so = ChainSolverOptions(ordering, options_.smoother.max_iterations, options_.smoother.function_tolerance,
-                            options_.smoother.num_threads);
+    so = ChainSolverOptions(ordering, smoother_options_.max_iterations, smoother_options_.function_tolerance,
+                            smoother_options_.num_threads);
   } else {
     so.linear_solver_type = ceres::DENSE_SCHUR;
-    so.max_num_iterations = options_.smoother.max_iterations;
-    so.function_tolerance = options_.smoother.function_tolerance;
-    so.num_threads = options_.smoother.num_threads;
+    so.max_num_iterations = smoother_options_.max_iterations;
+    so.function_tolerance = smoother_options_.function_tolerance;
+    so.num_threads = smoother_options_.num_threads;
     so.logging_type = ceres::SILENT;
   }
   ceres::Solver::Summary summary;
@@ -314,7 +321,7 @@ void Smoother::SolveAndSlide() {
   ReintegrateIfNeeded();
   // One covariance recovery for the gates (the two newest keyframes) and, when the window slides, for the
   // keyframe leaving it.
-  const bool slide = static_cast<int>(window_.size()) > options_.smoother.window_size;
+  const bool slide = static_cast<int>(window_.size()) > smoother_options_.window_size;
   MatX oldest_cov;
   UpdateNewestCovariance(slide ? &oldest_cov : nullptr);
   const double dt = Seconds(std::chrono::steady_clock::now() - t0);
@@ -336,7 +343,7 @@ void Smoother::SolveAndSlide() {
   pred_.t = t_now_;
   if (on_online_) on_online_(EstimateOf(newest, nullptr));
   if (slide) MarginalizeOldest(oldest_cov.size() > 0 ? &oldest_cov : nullptr);
-  while (static_cast<int>(window_.size()) > options_.smoother.window_size) MarginalizeOldest(nullptr);
+  while (static_cast<int>(window_.size()) > smoother_options_.window_size) MarginalizeOldest(nullptr);
 }
 
 void Smoother::ReintegrateIfNeeded() {
@@ -344,7 +351,7 @@ void Smoother::ReintegrateIfNeeded() {
     Keyframe& prev = window_[i - 1];
     Keyframe& kf = window_[i];
     if (kf.imu_id == nullptr) continue;
-    auto fresh = ReintegratedIfMoved(prev, *kf.preint, options_.smoother.bias_reintegrate_threshold);
+    auto fresh = ReintegratedIfMoved(prev, *kf.preint, smoother_options_.bias_reintegrate_threshold);
     if (!fresh) continue;
     problem_->RemoveResidualBlock(kf.imu_id);
     if (factor_log_) factor_log_->Deactivate(kf.imu_log_index);
@@ -417,7 +424,7 @@ void Smoother::Finish() {
   window_.Clear();
   initialized_ = false;
   if (on_batch_) {
-    BatchSmoother batch(options_, options_.batch, options_.smoother, window_.EstimatedTypes());
+    BatchSmoother batch(sensors_, batch_options_, smoother_options_, window_.EstimatedTypes());
     batch.Solve(factor_log_.get(), earth_);
     batch.Emit(*factor_log_, earth_, pre_init_.TwoSided(on_batch_));
     batch_stats_ = batch.stats().ToJson();
@@ -442,7 +449,7 @@ nlohmann::json Smoother::Stats() const {
   j["prior_reliefs"] = prior_reliefs_;
   for (const auto& attacher : attachers_) attacher->AddStats(&j);
   j["final_odom_scale"] = last_scale_;
-  j["time_offset"] = TimeOffsetJson(options_.gnss, final_time_offset_, final_time_offset_sigma_);
+  j["time_offset"] = TimeOffsetJson(sensors_.gnss, final_time_offset_, final_time_offset_sigma_);
   imu_gaps_.ToJson(&j);
   j[summary_keys::kWatchdog] = watchdog_.ToJson();
   if (on_batch_) j["batch"] = batch_stats_;

@@ -48,10 +48,13 @@ namespace gins {
 
 class Smoother : public Estimator {
  public:
+  // The sections it reads: the sensors, eskf.* (the ESKF that runs backwards before the initialisation,
+  // solver/pre_init_backward.h), smoother.*, batch.* (with on_batch), standstill.* and watchdog.*.
   // on_batch (optional): the whole-log solution (solver/batch_smoother.h), emitted at Finish; the window
   // then keeps every factor and keyframe it built.
-  Smoother(const EstimatorOptions& options, StateCallback on_final, StateCallback on_online,
-           StateCallback on_batch = nullptr);
+  Smoother(const SensorOptions& sensors, const EskfOptions& eskf, const SmootherOptions& smoother,
+           const BatchOptions& batch, const StandstillOptions& standstill, const WatchdogOptions& watchdog,
+           StateCallback on_final, StateCallback on_online, StateCallback on_batch = nullptr);
   ~Smoother() override;
 
   std::string name() const override { return "smoother"; }
@@ -79,7 +82,7 @@ class Smoother : public Estimator {
   // raw updates yet.
   void Use(const RawGnssMeasurement& x, const Measurement& /*m*/) {
     if (x.has_fix) Add(x.fix);
-    if (x.has_velocity && options_.gnss.use_velocity) Add(x.velocity);
+    if (x.has_velocity && sensors_.gnss.use_velocity) Add(x.velocity);
   }
   // Offers m to every attacher; true if one asks for a solve before the next IMU sample.
   bool Attach(const Measurement& m);
@@ -113,14 +116,19 @@ class Smoother : public Estimator {
   // A keyframe leaves the window: its final estimate and the IMU-rate states after it.
   void OutputFinal(const Keyframe& kf, const Keyframe* next, const Mat15* cov);
 
-  EstimatorOptions options_;
+  SensorOptions sensors_;
+  EskfOptions eskf_options_;
+  SmootherOptions smoother_options_;
+  BatchOptions batch_options_;
+  StandstillOptions standstill_options_;
+  WatchdogOptions watchdog_options_;
   StateCallback on_final_, on_online_;
   EarthModel earth_;
   Vec3 g_w_ = Vec3::Zero();  // gravity at the newest prediction (the attachers read it)
   bool initialized_ = false;
 
   StateCallback on_batch_;
-  PreInitOutput pre_init_{BridgeNoise{options_.imu.gyro_noise_density, options_.imu.acc_noise_density}};
+  PreInitOutput pre_init_{BridgeNoise{sensors_.imu.gyro_noise_density, sensors_.imu.acc_noise_density}};
   std::unique_ptr<FactorLog> factor_log_;  // with on_batch_; before window_, which records into it
   nlohmann::json batch_stats_;
   KeyframeStore window_;

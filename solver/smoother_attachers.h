@@ -62,10 +62,9 @@ struct Anchor {
 };
 
 // What the smoother lends an attacher: the window (its problem, factors with first-estimate Jacobians), the
-// options, the Earth, the IMU stream, and its services.
+// Earth, the IMU stream, and its services (an attacher holds the options it reads).
 struct AttachContext {
   KeyframeStore& keyframes;
-  const EstimatorOptions& options;
   const EarthModel& earth;
   const std::optional<ImuSample>& last_imu;
   std::function<Prediction(double t)> predict;

@@ -21,7 +21,7 @@ namespace gins {
 void Smoother::Use(const GnssMeasurement& m, const Measurement& measurement) {
   if (!initialized_ || m.t < t_now_ - kSameEpoch || m.t < window_.back().t - kSameEpoch) return;
   if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
-  if (options_.watchdog.enabled) {
+  if (watchdog_options_.enabled) {
     // The σ at the fix, predicted from the newest keyframe, and that of the keyframe that left the window
     // last (a window behind, it lags a long gap by a window's time).
     const Prediction p = PredictAt(m.t);
@@ -29,7 +29,7 @@ void Smoother::Use(const GnssMeasurement& m, const Measurement& measurement) {
     const double sigma_p = std::sqrt(P.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
     const bool finite = window_.back().State().AllFinite() && pred_.AllFinite() && std::isfinite(sigma_p);
     const FixVerdict verdict =
-        WatchdogVerdict(m, finite, std::max(sigma_p, last_sigma_p_), options_, options_.watchdog, p.x, P, &course_wait_, &prev_fix_);
+        WatchdogVerdict(m, finite, std::max(sigma_p, last_sigma_p_), sensors_, watchdog_options_, p.x, P, &course_wait_, &prev_fix_);
     if (verdict != FixVerdict::kUse) {
       if (verdict == FixVerdict::kReset) {
         ResetFromGnss(m, finite ? "covariance" : "non_finite");
@@ -80,13 +80,13 @@ void Smoother::ResetFromGnss(const GnssMeasurement& m, const std::string& reason
     init.x0 = at_fix.AllFinite() ? at_fix : window_.front().State();
     window_.KeepValues(window_.front());
   } else {
-    init.x0.q_wb = FallbackAttitude(m, options_.gnss);
+    init.x0.q_wb = FallbackAttitude(m, sensors_.gnss);
     window_.ForgetValues();
   }
-  if (!have_cov) cov = FallbackCovariance(options_.imu);
+  if (!have_cov) cov = FallbackCovariance(sensors_.imu);
   init.g_norm = earth_.g_norm();
   init.earth = earth_;
-  const FixReset how = ResetPositionFromFix(m, prev_fix_, options_, options_.watchdog, &init.x0, cov, course_wait_.Take());
+  const FixReset how = ResetPositionFromFix(m, prev_fix_, sensors_, watchdog_options_, &init.x0, cov, course_wait_.Take());
   // Tiny floors keep the prior invertible whatever the window's covariance was.
   cov = 0.5 * (cov + cov.transpose());
   cov.diagonal() = cov.diagonal().cwiseMax(1e-12);

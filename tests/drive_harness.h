@@ -10,8 +10,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "config/options.h"
 #include "core/sim/simulator.h"
 #include "core/so3.h"
+#include "estimators_from_options.h"
 #include "sim_feed.h"
 #include "solver/eskf.h"
 #include "solver/estimator_pipeline.h"
@@ -35,22 +37,22 @@ struct DriveRun {
 using RecordHook = std::function<void(const SimRecord& rec, const std::function<void(const SimRecord&)>& feed,
                                       EstimatorPipeline& session)>;
 
-inline DriveRun RunDriveThroughSession(const SimOptions& sim, const EstimatorOptions& options,
+inline DriveRun RunDriveThroughSession(const SimOptions& sim, const Options& options,
                                        const RecordHook& hook = nullptr, bool with_eskf = true,
                                        bool with_smoother = true, bool with_smoothing = false) {
   DriveRun out;
   Simulator simulator(sim);
-  EstimatorPipeline session(options);
+  EstimatorPipeline session(options.sensors, options.init, options.standstill);
   if (with_eskf) {
     StateCallback rts;
     if (with_smoothing) rts = [&](const StateEstimate& e) { out.eskf_rts.push_back(e); };
     session.AddEstimator(
-        std::make_unique<Eskf>(options, [&](const StateEstimate& e) { out.eskf.push_back(e); }, std::move(rts)));
+        test::MakeEskf(options, [&](const StateEstimate& e) { out.eskf.push_back(e); }, std::move(rts)));
   }
   if (with_smoother) {
     StateCallback batch;
     if (with_smoothing) batch = [&](const StateEstimate& e) { out.batch.push_back(e); };
-    session.AddEstimator(std::make_unique<Smoother>(
+    session.AddEstimator(test::MakeSmoother(
         options, [&](const StateEstimate& e) { out.smoother.push_back(e); },
         [&](const StateEstimate& e) { out.smoother_online.push_back(e); }, std::move(batch)));
   }

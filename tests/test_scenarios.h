@@ -54,16 +54,16 @@ inline SimOptions TestDrive(unsigned seed) {
 // estimates share coordinates.
 inline Options TestRunOptions(const SimOptions& sim) {
   Options o;
-  o.gnss.origin = sim.origin;
-  o.gnss.lever_b = sim.lever_b;
-  o.gnss.mount_yaw = sim.mount_yaw;
-  o.wheel.radius = sim.wheel_radius;
-  o.wheel.pulses_per_rev = sim.pulses_per_rev;
-  o.wheel.interval = 1.0 / sim.wheel_rate;
+  o.sensors.gnss.origin = sim.origin;
+  o.sensors.gnss.lever_b = sim.lever_b;
+  o.sensors.gnss.mount_yaw = sim.mount_yaw;
+  o.sensors.wheel.radius = sim.wheel_radius;
+  o.sensors.wheel.pulses_per_rev = sim.pulses_per_rev;
+  o.sensors.wheel.interval = 1.0 / sim.wheel_rate;
   // The simulated GNSS is stamped at its measurement time: stated, as a config states a known latency (the
   // default estimates it, at the cost of its σ along the track; cli_test's time-offset test covers that).
-  o.gnss.time_offset = 0.0;
-  o.gnss.estimate_time_offset = false;
+  o.sensors.gnss.time_offset = 0.0;
+  o.sensors.gnss.estimate_time_offset = false;
   return o;
 }
 

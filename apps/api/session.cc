@@ -70,19 +70,19 @@ class Session::Impl {
 Session::Impl::Impl(const Options& options, const SessionOptions& session_options)
     : options_(options),
       session_options_(session_options),
-      session_(options_),
+      session_(options_.sensors, options_.init, options_.standstill),
       // GNSS records taken back by gnss.time_offset_s must still find their place among the IMU's.
-      reorder_(options_.input.reorder_window + std::abs(options_.gnss.time_offset)),
-      imu_clock_(options_.imu.max_gap),
-      wheel_clock_(options_.imu.max_gap + options_.wheel.interval),
+      reorder_(options_.input.reorder_window + std::abs(options_.sensors.gnss.time_offset)),
+      imu_clock_(options_.sensors.imu.max_gap),
+      wheel_clock_(options_.sensors.imu.max_gap + options_.sensors.wheel.interval),
       imu_range_(ReaderOptions(options_).imu_range) {
   session_.SetParallel(session_options_.parallel);
-  if (!options_.gnss.raw.obs_file.empty() || !options_.gnss.raw.nav_file.empty()) {
-    if (options_.gnss.raw.obs_file.empty() || options_.gnss.raw.nav_file.empty()) {
+  if (!options_.sensors.gnss.raw.obs_file.empty() || !options_.sensors.gnss.raw.nav_file.empty()) {
+    if (options_.sensors.gnss.raw.obs_file.empty() || options_.sensors.gnss.raw.nav_file.empty()) {
       throw Error(Error::Kind::kConfig, "raw_gnss: obs_file and nav_file go together (gins run --obs OBS --nav NAV)");
     }
     try {
-      session_.SetRawGnssFeed(std::make_unique<RawGnssFeed>(options_.gnss.raw, options_.input));
+      session_.SetRawGnssFeed(std::make_unique<RawGnssFeed>(options_.sensors.gnss.raw, options_.input));
     } catch (const InputError& e) {
       throw Error(Error::Kind::kInput, e.what());
     }
@@ -93,7 +93,8 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
     ::gins::StateCallback rts;
     if (all) rts = [this](const StateEstimate& e) { Emit(Stream::kEskfRts, e); };
     session_.AddEstimator(std::make_unique<Eskf>(
-        options_, [this](const StateEstimate& e) { Emit(Stream::kEskf, e); }, std::move(rts)));
+        options_.sensors, options_.eskf, options_.standstill, options_.watchdog,
+        [this](const StateEstimate& e) { Emit(Stream::kEskf, e); }, std::move(rts)));
   }
   if (mode == Mode::kSmoother || mode == Mode::kBoth || mode == Mode::kBatch || all) {
     // Batch alone: the window runs as the batch's forward pass, its own streams not delivered.
@@ -101,7 +102,8 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
     ::gins::StateCallback batch;
     if (mode == Mode::kBatch || all) batch = [this](const StateEstimate& e) { Emit(Stream::kBatch, e); };
     session_.AddEstimator(std::make_unique<Smoother>(
-        options_, window ? ::gins::StateCallback([this](const StateEstimate& e) { Emit(Stream::kSmoother, e); }) : nullptr,
+        options_.sensors, options_.eskf, options_.smoother, options_.batch, options_.standstill, options_.watchdog,
+        window ? ::gins::StateCallback([this](const StateEstimate& e) { Emit(Stream::kSmoother, e); }) : nullptr,
         window ? ::gins::StateCallback([this](const StateEstimate& e) { Emit(Stream::kSmootherOnline, e); }) : nullptr,
         std::move(batch)));
   }
@@ -111,8 +113,8 @@ bool Session::Impl::Push(LogRecord record) {
   if (finished_) throw Error(Error::Kind::kUsage, "gins::api::Session: Push after Finish");
   if (CheckLogRecord(&record, &issue_, imu_range_) == LineParse::kDamaged) return Reject(record.type, issue_.reason);
   // At the IMU time of their measurement (gnss.time_offset_s).
-  if (record.type == LogRecord::Type::kGnss) record.gnss.t -= options_.gnss.time_offset;
-  if (record.type == LogRecord::Type::kGnssVelocity) record.gnss_velocity.t -= options_.gnss.time_offset;
+  if (record.type == LogRecord::Type::kGnss) record.gnss.t -= options_.sensors.gnss.time_offset;
+  if (record.type == LogRecord::Type::kGnssVelocity) record.gnss_velocity.t -= options_.sensors.gnss.time_offset;
   if (options_.input.regularize_stamps) {
     if (record.type == LogRecord::Type::kImu) record.imu.t = imu_clock_.Stamp(record.imu.t);
     if (record.type == LogRecord::Type::kWheel) record.wheel.t = wheel_clock_.Stamp(record.wheel.t);

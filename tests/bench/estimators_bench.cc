@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/sim/simulator.h"
+#include "estimators_from_options.h"
 #include "solver/eskf.h"
 #include "solver/estimator_pipeline.h"
 #include "solver/smoother.h"
@@ -37,7 +38,7 @@ void RunDrive(benchmark::State& state, MakeEstimator make) {
   const Options options = test::TestRunOptions(test::TestDrive(1));
   int64_t imu = 0, gnss = 0;
   for (auto _ : state) {
-    EstimatorPipeline session(options);
+    EstimatorPipeline session(options.sensors, options.init, options.standstill);
     session.AddEstimator(make(options));
     for (const auto& r : records) {
       test::FeedSession(&session, r);
@@ -53,12 +54,12 @@ void RunDrive(benchmark::State& state, MakeEstimator make) {
 }
 
 void BM_EskfDrive(benchmark::State& state) {
-  RunDrive(state, [](const Options& o) { return std::make_unique<Eskf>(o, nullptr); });
+  RunDrive(state, [](const Options& o) { return test::MakeEskf(o, nullptr); });
 }
 BENCHMARK(BM_EskfDrive)->Unit(benchmark::kMillisecond);
 
 void BM_SmootherDrive(benchmark::State& state) {
-  RunDrive(state, [](const Options& o) { return std::make_unique<Smoother>(o, nullptr, nullptr); });
+  RunDrive(state, [](const Options& o) { return test::MakeSmoother(o, nullptr, nullptr); });
 }
 BENCHMARK(BM_SmootherDrive)->Unit(benchmark::kMillisecond);
 
@@ -66,9 +67,9 @@ BENCHMARK(BM_SmootherDrive)->Unit(benchmark::kMillisecond);
 class EskfFixture {
  public:
   explicit EskfFixture(const Options& options = test::TestRunOptions(test::TestDrive(1))) : options_(options) {
-    auto eskf = std::make_unique<Eskf>(options_, nullptr);
+    auto eskf = test::MakeEskf(options_, nullptr);
     eskf_ = eskf.get();
-    session_ = std::make_unique<EstimatorPipeline>(options_);
+    session_ = std::make_unique<EstimatorPipeline>(options_.sensors, options_.init, options_.standstill);
     session_->AddEstimator(std::move(eskf));
     for (const auto& r : DriveRecords()) {
       test::FeedSession(session_.get(), r);
@@ -123,7 +124,7 @@ void CheckAllUsed(benchmark::State& state, const nlohmann::json& counts, uint64_
 void BM_EskfWheelUpdate(benchmark::State& state) {
   const bool nhc = state.range(0) != 0;
   Options options = test::TestRunOptions(test::TestDrive(1));
-  options.vehicle.nonholonomic = nhc;
+  options.sensors.vehicle.nonholonomic = nhc;
   EskfFixture f(options);
   const uint64_t used0 = f.eskf()->Stats()["wheel"]["used"].get<uint64_t>();
   WheelMeasurement w;
@@ -239,7 +240,7 @@ const StepDriveInputs& StepInputs() {
     const SimOptions sim = StepDrive();
     out.options = test::TestRunOptions(sim);
     out.start_time = sim.start_time;
-    EstimatorPipeline session(out.options);
+    EstimatorPipeline session(out.options.sensors, out.options.init, out.options.standstill);
     session.AddEstimator(std::make_unique<Recorder>(&out.init, &out.inputs));
     Simulator simulator(sim);
     SimRecord r;
@@ -255,7 +256,9 @@ const StepDriveInputs& StepInputs() {
 // one fix with heading): one keyframe, one solve, one marginalisation.
 class SmootherFixture {
  public:
-  SmootherFixture() : smoother_(StepInputs().options, nullptr, nullptr) {
+  SmootherFixture() : SmootherFixture(StepInputs().options) {}
+  explicit SmootherFixture(const Options& o)
+      : smoother_(o.sensors, o.eskf, o.smoother, o.batch, o.standstill, o.watchdog, nullptr, nullptr) {
     const StepDriveInputs& in = StepInputs();
     smoother_.Initialize(in.init);
     const double t_start = in.start_time + 40.0;  // 20 s standstill, 10 s to 10 m/s, 10 s of driving

@@ -8,9 +8,9 @@
 #include <random>
 #include <vector>
 
-#include "config/options.h"
 #include "core/imu_kernel.h"
 #include "core/preintegration.h"
+#include "core/sensors.h"
 #include "core/so3.h"
 #include "factors/bias_rw_factor.h"
 #include "factors/gnss_factor.h"
@@ -141,7 +141,7 @@ class KeyframeChain {
   };
 
   KeyframeChain() {
-    const Options o;
+    const SensorOptions sensors;
     const Vec3 g_w = GravityWorld(kStandardGravity), lever_b(-0.17, -0.2, 0.0);
     const double mount_yaw = 0.21, true_scale = 0.99;
     Vec6 bias_true;
@@ -166,7 +166,7 @@ class KeyframeChain {
       wheel_.emplace_back(WheelFactor::Create(true_scale * (x.q.conjugate() * x.v).x() + 0.01, 0.05));
       if (i + 1 == kNumKf) break;
       auto pre = std::make_shared<Preintegration>(bias_true.head<3>(), bias_true.tail<3>(),
-                                                  o.imu.gyro_noise_density, o.imu.acc_noise_density);
+                                                  sensors.imu.gyro_noise_density, sensors.imu.acc_noise_density);
       for (int k = 0; k < 100; ++k) {
         const double t = i + 0.01 * k;
         const Vec3 omega(0.01 * std::sin(t), 0.02 * std::cos(t), 0.1);
@@ -175,8 +175,8 @@ class KeyframeChain {
         x = ImuStep(x, omega, acc, g_w, 0.01);
       }
       imu_.emplace_back(ImuFactor::Create(pre, g_w));
-      bias_rw_.emplace_back(BiasRwFactor::Create(o.imu.gyro_bias_rw, o.imu.acc_bias_rw, 1.0));
-      scale_rw_.emplace_back(ScaleRwFactor::Create(o.wheel.scale_rw, 1.0));
+      bias_rw_.emplace_back(BiasRwFactor::Create(sensors.imu.gyro_bias_rw, sensors.imu.acc_bias_rw, 1.0));
+      scale_rw_.emplace_back(ScaleRwFactor::Create(sensors.wheel.scale_rw, 1.0));
     }
     // Initial prior on keyframe 0: diagonal, as from an initialisation covariance.
     Eigen::Matrix<double, 16, 1> sigma;  // tangent order: δp, δθ (pose), v, bg, ba, s

@@ -68,43 +68,43 @@ Comparison Compare(const Options& a, const Options& b) {
   GINS_FIELD(input.max_errors);
   GINS_FIELD(input.max_line_length);
   GINS_FIELD(input.max_time_jump);
-  GINS_FIELD(imu.R_b_imu);
-  GINS_FIELD(imu.gyro_noise_density);
-  GINS_FIELD(imu.acc_noise_density);
-  GINS_FIELD(imu.gyro_bias_rw);
-  GINS_FIELD(imu.acc_bias_rw);
-  GINS_FIELD(imu.init_gyro_bias_sigma);
-  GINS_FIELD(imu.init_acc_bias_sigma);
-  GINS_FIELD(imu.max_gap);
-  GINS_FIELD(imu.max_gyro);
-  GINS_FIELD(imu.max_acc);
-  GINS_FIELD(gnss.lever_b);
-  GINS_FIELD(gnss.mount_yaw);
-  GINS_FIELD(gnss.sigma_enu);
-  GINS_FIELD(gnss.min_sigma);
-  GINS_FIELD(gnss.heading_sigma);
-  GINS_FIELD(gnss.use_heading);
-  GINS_FIELD(gnss.gate_probability);
-  GINS_FIELD(gnss.origin);
-  GINS_FIELD(gnss.outages);
-  GINS_FIELD(gnss.periodic_outages);
-  GINS_FIELD(wheel.enabled);
-  GINS_FIELD(wheel.radius);
-  GINS_FIELD(wheel.pulses_per_rev);
-  GINS_FIELD(wheel.interval);
-  GINS_FIELD(wheel.speed_sigma);
-  GINS_FIELD(wheel.gate_probability);
-  GINS_FIELD(wheel.scale_sigma);
-  GINS_FIELD(wheel.scale_rw);
-  GINS_FIELD(wheel.estimate_scale);
-  GINS_FIELD(wheel.lever_b);
-  GINS_FIELD(wheel.track);
-  GINS_FIELD(vehicle.nonholonomic);
-  GINS_FIELD(vehicle.nhc_sigma);
-  GINS_FIELD(vehicle.nhc_rate);
-  GINS_FIELD(gravity.earth_rotation);
-  GINS_FIELD(gravity.use_normal_gravity);
-  GINS_FIELD(gravity.magnitude);
+  GINS_FIELD(sensors.imu.R_b_imu);
+  GINS_FIELD(sensors.imu.gyro_noise_density);
+  GINS_FIELD(sensors.imu.acc_noise_density);
+  GINS_FIELD(sensors.imu.gyro_bias_rw);
+  GINS_FIELD(sensors.imu.acc_bias_rw);
+  GINS_FIELD(sensors.imu.init_gyro_bias_sigma);
+  GINS_FIELD(sensors.imu.init_acc_bias_sigma);
+  GINS_FIELD(sensors.imu.max_gap);
+  GINS_FIELD(sensors.imu.max_gyro);
+  GINS_FIELD(sensors.imu.max_acc);
+  GINS_FIELD(sensors.gnss.lever_b);
+  GINS_FIELD(sensors.gnss.mount_yaw);
+  GINS_FIELD(sensors.gnss.sigma_enu);
+  GINS_FIELD(sensors.gnss.min_sigma);
+  GINS_FIELD(sensors.gnss.heading_sigma);
+  GINS_FIELD(sensors.gnss.use_heading);
+  GINS_FIELD(sensors.gnss.gate_probability);
+  GINS_FIELD(sensors.gnss.origin);
+  GINS_FIELD(sensors.gnss.outages);
+  GINS_FIELD(sensors.gnss.periodic_outages);
+  GINS_FIELD(sensors.wheel.enabled);
+  GINS_FIELD(sensors.wheel.radius);
+  GINS_FIELD(sensors.wheel.pulses_per_rev);
+  GINS_FIELD(sensors.wheel.interval);
+  GINS_FIELD(sensors.wheel.speed_sigma);
+  GINS_FIELD(sensors.wheel.gate_probability);
+  GINS_FIELD(sensors.wheel.scale_sigma);
+  GINS_FIELD(sensors.wheel.scale_rw);
+  GINS_FIELD(sensors.wheel.estimate_scale);
+  GINS_FIELD(sensors.wheel.lever_b);
+  GINS_FIELD(sensors.wheel.track);
+  GINS_FIELD(sensors.vehicle.nonholonomic);
+  GINS_FIELD(sensors.vehicle.nhc_sigma);
+  GINS_FIELD(sensors.vehicle.nhc_rate);
+  GINS_FIELD(sensors.gravity.earth_rotation);
+  GINS_FIELD(sensors.gravity.use_normal_gravity);
+  GINS_FIELD(sensors.gravity.magnitude);
   GINS_FIELD(init.static_duration);
   GINS_FIELD(init.max_wait);
   GINS_FIELD(init.wait_for_heading);
@@ -177,43 +177,43 @@ Options NonDefaultOptions() {
   o.input.max_errors = 7;
   o.input.max_line_length = 300;
   o.input.max_time_jump = 3600.0;
-  o.imu.R_b_imu << 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0;  // a proper rotation, not a named one
-  o.imu.gyro_noise_density = 0.15 * kDegToRad / 60.0;
-  o.imu.acc_noise_density = 0.03 / 60.0;
-  o.imu.gyro_bias_rw = 3.0 * kDegToRad / 3600.0 / 60.0;
-  o.imu.acc_bias_rw = 0.004 / 60.0;
-  o.imu.init_gyro_bias_sigma = 50.0 * kDegToRad / 3600.0;
-  o.imu.init_acc_bias_sigma = 0.02;
-  o.imu.max_gap = 0.25;
-  o.imu.max_gyro = 10.0;
-  o.imu.max_acc = 80.0;
-  o.gnss.lever_b = Vec3(0.5, -0.25, 1.125);
-  o.gnss.mount_yaw = -90.0 * kDegToRad;
-  o.gnss.sigma_enu = Vec3(1.5, 1.6, 3.1);
-  o.gnss.min_sigma = 0.3;
-  o.gnss.heading_sigma = 1.5 * kDegToRad;
-  o.gnss.use_heading = false;
-  o.gnss.gate_probability = 0.0;
-  o.gnss.origin = GeodeticPoint{39.668529021, -79.970733949, 287.8759};
-  o.gnss.outages = {{300.0, 60.0}, {512.5, 30.0}};
-  o.gnss.periodic_outages = {250.0, 60.0, 180.0};
-  o.wheel.enabled = false;
-  o.wheel.radius = 0.11;
-  o.wheel.pulses_per_rev = 2048;
-  o.wheel.interval = 0.05;
-  o.wheel.speed_sigma = 0.07;
-  o.wheel.gate_probability = 0.999;
-  o.wheel.scale_sigma = 0.02;
-  o.wheel.scale_rw = 3e-5;
-  o.wheel.estimate_scale = false;
-  o.wheel.lever_b = Vec3(-1.5, 0.0, -0.3);
-  o.wheel.track = 1.55;
-  o.vehicle.nonholonomic = false;
-  o.vehicle.nhc_sigma = 0.3;
-  o.vehicle.nhc_rate = 5.0;
-  o.gravity.earth_rotation = false;
-  o.gravity.use_normal_gravity = false;
-  o.gravity.magnitude = 9.7936;
+  o.sensors.imu.R_b_imu << 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0;  // a proper rotation, not a named one
+  o.sensors.imu.gyro_noise_density = 0.15 * kDegToRad / 60.0;
+  o.sensors.imu.acc_noise_density = 0.03 / 60.0;
+  o.sensors.imu.gyro_bias_rw = 3.0 * kDegToRad / 3600.0 / 60.0;
+  o.sensors.imu.acc_bias_rw = 0.004 / 60.0;
+  o.sensors.imu.init_gyro_bias_sigma = 50.0 * kDegToRad / 3600.0;
+  o.sensors.imu.init_acc_bias_sigma = 0.02;
+  o.sensors.imu.max_gap = 0.25;
+  o.sensors.imu.max_gyro = 10.0;
+  o.sensors.imu.max_acc = 80.0;
+  o.sensors.gnss.lever_b = Vec3(0.5, -0.25, 1.125);
+  o.sensors.gnss.mount_yaw = -90.0 * kDegToRad;
+  o.sensors.gnss.sigma_enu = Vec3(1.5, 1.6, 3.1);
+  o.sensors.gnss.min_sigma = 0.3;
+  o.sensors.gnss.heading_sigma = 1.5 * kDegToRad;
+  o.sensors.gnss.use_heading = false;
+  o.sensors.gnss.gate_probability = 0.0;
+  o.sensors.gnss.origin = GeodeticPoint{39.668529021, -79.970733949, 287.8759};
+  o.sensors.gnss.outages = {{300.0, 60.0}, {512.5, 30.0}};
+  o.sensors.gnss.periodic_outages = {250.0, 60.0, 180.0};
+  o.sensors.wheel.enabled = false;
+  o.sensors.wheel.radius = 0.11;
+  o.sensors.wheel.pulses_per_rev = 2048;
+  o.sensors.wheel.interval = 0.05;
+  o.sensors.wheel.speed_sigma = 0.07;
+  o.sensors.wheel.gate_probability = 0.999;
+  o.sensors.wheel.scale_sigma = 0.02;
+  o.sensors.wheel.scale_rw = 3e-5;
+  o.sensors.wheel.estimate_scale = false;
+  o.sensors.wheel.lever_b = Vec3(-1.5, 0.0, -0.3);
+  o.sensors.wheel.track = 1.55;
+  o.sensors.vehicle.nonholonomic = false;
+  o.sensors.vehicle.nhc_sigma = 0.3;
+  o.sensors.vehicle.nhc_rate = 5.0;
+  o.sensors.gravity.earth_rotation = false;
+  o.sensors.gravity.use_normal_gravity = false;
+  o.sensors.gravity.magnitude = 9.7936;
   o.init.static_duration = 5.0;
   o.init.max_wait = 60.0;
   o.init.wait_for_heading = true;
@@ -313,12 +313,12 @@ TEST(ConfigLoaderTest, EmptyOrCommentOnlyTextGivesDefaults) {
 
 TEST(ConfigLoaderTest, WvuRoverConfigLoads) {
   const Options o = LoadOptions(kConfigDir + "wvu_rover.yaml");
-  EXPECT_FALSE(o.gnss.use_heading);
+  EXPECT_FALSE(o.sensors.gnss.use_heading);
   EXPECT_FALSE(o.init.wait_for_heading);
-  EXPECT_EQ(o.gnss.lever_b, Vec3::Zero());
-  EXPECT_EQ(o.wheel.radius, 0.11);
-  EXPECT_EQ(o.wheel.pulses_per_rev, 1024.0);
-  EXPECT_EQ(o.imu.R_b_imu, Mat3::Identity());
+  EXPECT_EQ(o.sensors.gnss.lever_b, Vec3::Zero());
+  EXPECT_EQ(o.sensors.wheel.radius, 0.11);
+  EXPECT_EQ(o.sensors.wheel.pulses_per_rev, 1024.0);
+  EXPECT_EQ(o.sensors.imu.R_b_imu, Mat3::Identity());
   EXPECT_DOUBLE_EQ(o.init.static_duration, 2.0);
 }
 
@@ -326,7 +326,7 @@ TEST(ConfigLoaderTest, WvuRoverConfigLoads) {
 TEST(ConfigLoaderTest, OutagesScenarioIsDefaultsPlusOutages) {
   const Options o = LoadOptions(kConfigDir + "outages_3x60s.yaml");
   Options expected;
-  expected.gnss.outages = {{300.0, 60.0}, {650.0, 60.0}, {850.0, 60.0}};
+  expected.sensors.gnss.outages = {{300.0, 60.0}, {650.0, 60.0}, {850.0, 60.0}};
   ExpectSameOptions(o, expected);
 }
 
@@ -336,10 +336,10 @@ TEST(ConfigLoaderTest, SimSampleConfigLoadsAndDescribesTheSampleDrive) {
   Options expected = o;
   const Options defaults;
   expected.input = defaults.input;
-  expected.imu = defaults.imu;
-  expected.gnss = defaults.gnss;
-  expected.wheel = defaults.wheel;
-  expected.gravity = defaults.gravity;
+  expected.sensors.imu = defaults.sensors.imu;
+  expected.sensors.gnss = defaults.sensors.gnss;
+  expected.sensors.wheel = defaults.sensors.wheel;
+  expected.sensors.gravity = defaults.sensors.gravity;
   expected.init = defaults.init;
   expected.eskf = defaults.eskf;
   expected.smoother = defaults.smoother;
@@ -401,19 +401,19 @@ simulate:
 )");
   const double rel = 1e-15;
   // deg/√h → rad/s/√Hz: ×π/180/60.  0.15 deg/√h = 4.3633e-5 rad/s/√Hz.
-  EXPECT_NEAR(o.imu.gyro_noise_density, 0.15 * kPi / 180.0 / 60.0, rel * 1e-4);
-  EXPECT_NEAR(o.imu.gyro_noise_density, 4.36332e-5, 1e-10);
+  EXPECT_NEAR(o.sensors.imu.gyro_noise_density, 0.15 * kPi / 180.0 / 60.0, rel * 1e-4);
+  EXPECT_NEAR(o.sensors.imu.gyro_noise_density, 4.36332e-5, 1e-10);
   // m/s/√h → m/s²/√Hz: /60.
-  EXPECT_NEAR(o.imu.acc_noise_density, 0.0005, rel);
+  EXPECT_NEAR(o.sensors.imu.acc_noise_density, 0.0005, rel);
   // deg/h/√h → rad/s/√s: ×π/180/3600/60.
-  EXPECT_NEAR(o.imu.gyro_bias_rw, 3.0 * kPi / 180.0 / 216000.0, rel * 1e-6);
+  EXPECT_NEAR(o.sensors.imu.gyro_bias_rw, 3.0 * kPi / 180.0 / 216000.0, rel * 1e-6);
   // m/s²/√h → m/s²/√s: /60.
-  EXPECT_NEAR(o.imu.acc_bias_rw, 1e-4, rel);
+  EXPECT_NEAR(o.sensors.imu.acc_bias_rw, 1e-4, rel);
   // deg/h → rad/s: 36 deg/h = 0.01 deg/s.
-  EXPECT_NEAR(o.imu.init_gyro_bias_sigma, 0.01 * kPi / 180.0, rel);
+  EXPECT_NEAR(o.sensors.imu.init_gyro_bias_sigma, 0.01 * kPi / 180.0, rel);
   EXPECT_NEAR(o.simulate.gyro_turn_on_bias, 0.1 * kPi / 180.0, rel);
-  EXPECT_NEAR(o.gnss.mount_yaw, kPi / 2.0, rel);
-  EXPECT_NEAR(o.gnss.heading_sigma, 2.0 * kPi / 180.0, rel);
+  EXPECT_NEAR(o.sensors.gnss.mount_yaw, kPi / 2.0, rel);
+  EXPECT_NEAR(o.sensors.gnss.heading_sigma, 2.0 * kPi / 180.0, rel);
   EXPECT_NEAR(o.init.max_attitude_sigma, kPi / 180.0, rel);
   ASSERT_EQ(o.simulate.segments.size(), 1u);
   EXPECT_NEAR(o.simulate.segments[0].yaw_rate, 9.0 * kPi / 180.0, rel);
@@ -431,24 +431,25 @@ TEST(ConfigLoaderTest, CompassHeadingToEnuYaw) {
 
 TEST(ConfigLoaderTest, ImuAxesNamesAndMatrices) {
   const Vec3 v_imu(1.0, 2.0, 3.0);
-  EXPECT_EQ(Load("imu: {axes: FLU}").imu.R_b_imu * v_imu, Vec3(1.0, 2.0, 3.0));
-  EXPECT_EQ(Load("imu: {axes: FRD}").imu.R_b_imu * v_imu, Vec3(1.0, -2.0, -3.0));
+  EXPECT_EQ(Load("imu: {axes: FLU}").sensors.imu.R_b_imu * v_imu, Vec3(1.0, 2.0, 3.0));
+  EXPECT_EQ(Load("imu: {axes: FRD}").sensors.imu.R_b_imu * v_imu, Vec3(1.0, -2.0, -3.0));
   // Right-forward-up: forward is logged y, left is minus logged x.
-  EXPECT_EQ(Load("imu: {axes: RFU}").imu.R_b_imu * v_imu, Vec3(2.0, -1.0, 3.0));
+  EXPECT_EQ(Load("imu: {axes: RFU}").sensors.imu.R_b_imu * v_imu, Vec3(2.0, -1.0, 3.0));
   Mat3 R;
   R << 0, 0, 1, 1, 0, 0, 0, 1, 0;
-  EXPECT_EQ(Load("imu: {axes: [0, 0, 1, 1, 0, 0, 0, 1, 0]}").imu.R_b_imu, R);
-  EXPECT_EQ(Load("imu: {axes: [[0, 0, 1], [1, 0, 0], [0, 1, 0]]}").imu.R_b_imu, R);
+  EXPECT_EQ(Load("imu: {axes: [0, 0, 1, 1, 0, 0, 0, 1, 0]}").sensors.imu.R_b_imu, R);
+  EXPECT_EQ(Load("imu: {axes: [[0, 0, 1], [1, 0, 0], [0, 1, 0]]}").sensors.imu.R_b_imu, R);
   // A 45° yaw typed with 7 digits is snapped to an exact rotation.
-  const Mat3 R45 = Load("imu: {axes: [0.7071068, -0.7071068, 0, 0.7071068, 0.7071068, 0, 0, 0, 1]}").imu.R_b_imu;
+  const Mat3 R45 =
+      Load("imu: {axes: [0.7071068, -0.7071068, 0, 0.7071068, 0.7071068, 0, 0, 0, 1]}").sensors.imu.R_b_imu;
   EXPECT_LT((R45 * R45.transpose() - Mat3::Identity()).norm(), 1e-14);
   EXPECT_NEAR(R45(0, 0), std::sqrt(0.5), 1e-7);
 }
 
 TEST(ConfigLoaderTest, GnssOriginNullOrPoint) {
-  EXPECT_FALSE(Load("gnss: {origin: null}").gnss.origin.has_value());
-  EXPECT_FALSE(Load("gnss:\n  origin:\n").gnss.origin.has_value());
-  const auto origin = Load("gnss: {origin: [31.5, -120.25, -20]}").gnss.origin;
+  EXPECT_FALSE(Load("gnss: {origin: null}").sensors.gnss.origin.has_value());
+  EXPECT_FALSE(Load("gnss:\n  origin:\n").sensors.gnss.origin.has_value());
+  const auto origin = Load("gnss: {origin: [31.5, -120.25, -20]}").sensors.gnss.origin;
   ASSERT_TRUE(origin.has_value());
   EXPECT_EQ(origin->lat_deg, 31.5);
   EXPECT_EQ(origin->lon_deg, -120.25);
@@ -457,8 +458,8 @@ TEST(ConfigLoaderTest, GnssOriginNullOrPoint) {
 
 TEST(ConfigLoaderTest, ZeroDisablesGates) {
   const Options o = Load("gnss: {gate_probability: 0}\nwheel: {gate_probability: 0}");
-  EXPECT_EQ(o.gnss.gate_probability, 0.0);
-  EXPECT_EQ(o.wheel.gate_probability, 0.0);
+  EXPECT_EQ(o.sensors.gnss.gate_probability, 0.0);
+  EXPECT_EQ(o.sensors.wheel.gate_probability, 0.0);
 }
 
 TEST(ConfigLoaderTest, EnumsAndBooleans) {
@@ -466,11 +467,11 @@ TEST(ConfigLoaderTest, EnumsAndBooleans) {
       "input: {on_error: stop}\ngravity: {model: fixed, magnitude_m_s2: 9.8}\n"
       "smoother: {linear_solver: dense_schur}\nwheel: {enabled: false}\nvehicle: {nonholonomic: false}");
   EXPECT_EQ(o.input.on_error, InputErrorPolicy::kStop);
-  EXPECT_FALSE(o.gravity.use_normal_gravity);
-  EXPECT_EQ(o.gravity.magnitude, 9.8);
+  EXPECT_FALSE(o.sensors.gravity.use_normal_gravity);
+  EXPECT_EQ(o.sensors.gravity.magnitude, 9.8);
   EXPECT_EQ(o.smoother.linear_solver, "dense_schur");
-  EXPECT_FALSE(o.wheel.enabled);
-  EXPECT_FALSE(o.vehicle.nonholonomic);
+  EXPECT_FALSE(o.sensors.wheel.enabled);
+  EXPECT_FALSE(o.sensors.vehicle.nonholonomic);
 }
 
 // ---- Errors ------------------------------------------------------------------------------------------------
@@ -583,16 +584,16 @@ TEST(ConfigLoaderTest, OutOfRangeValuesAreErrors) {
 
 TEST(ConfigLoaderTest, GnssOutages) {
   const Options none = Load("gnss: {outages_s: [], periodic_outages_s: []}");
-  EXPECT_TRUE(none.gnss.outages.empty());
-  EXPECT_EQ(none.gnss.periodic_outages.duration, 0.0);
-  EXPECT_EQ(Load("gnss: {periodic_outages_s: null}").gnss.periodic_outages.duration, 0.0);
+  EXPECT_TRUE(none.sensors.gnss.outages.empty());
+  EXPECT_EQ(none.sensors.gnss.periodic_outages.duration, 0.0);
+  EXPECT_EQ(Load("gnss: {periodic_outages_s: null}").sensors.gnss.periodic_outages.duration, 0.0);
   const Options o = Load("gnss:\n  outages_s: [[300, 60], [0, 0.5]]\n  periodic_outages_s: [250, 60, 180]\n");
-  ASSERT_EQ(o.gnss.outages.size(), 2u);
-  EXPECT_EQ(o.gnss.outages[0], std::make_pair(300.0, 60.0));
-  EXPECT_EQ(o.gnss.outages[1], std::make_pair(0.0, 0.5));
-  EXPECT_EQ(o.gnss.periodic_outages.first_start, 250.0);
-  EXPECT_EQ(o.gnss.periodic_outages.duration, 60.0);
-  EXPECT_EQ(o.gnss.periodic_outages.period, 180.0);
+  ASSERT_EQ(o.sensors.gnss.outages.size(), 2u);
+  EXPECT_EQ(o.sensors.gnss.outages[0], std::make_pair(300.0, 60.0));
+  EXPECT_EQ(o.sensors.gnss.outages[1], std::make_pair(0.0, 0.5));
+  EXPECT_EQ(o.sensors.gnss.periodic_outages.first_start, 250.0);
+  EXPECT_EQ(o.sensors.gnss.periodic_outages.duration, 60.0);
+  EXPECT_EQ(o.sensors.gnss.periodic_outages.period, 180.0);
   const std::string yaml = OptionsToYaml(o);
   EXPECT_NE(yaml.find("  outages_s: [[300, 60], [0, 0.5]]\n"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("  periodic_outages_s: [250, 60, 180]\n"), std::string::npos) << yaml;
@@ -713,14 +714,14 @@ TEST(ConfigLoaderTest, EchoWritesSegmentsOutagesAndMatrices) {
 // gnss.time_offset_s: a number (held) or `estimate` (a state in the ESKF); the writer writes back what was read.
 TEST(ConfigLoaderTest, GnssTimeOffsetIsANumberOrEstimate) {
   const Options held = Load("gnss: {time_offset_s: 0.12}");
-  EXPECT_EQ(held.gnss.time_offset, 0.12);
-  EXPECT_FALSE(held.gnss.estimate_time_offset);
+  EXPECT_EQ(held.sensors.gnss.time_offset, 0.12);
+  EXPECT_FALSE(held.sensors.gnss.estimate_time_offset);
   const Options estimated = Load("gnss: {time_offset_s: estimate, time_offset_sigma_s: 0.2}");
-  EXPECT_TRUE(estimated.gnss.estimate_time_offset);
-  EXPECT_EQ(estimated.gnss.time_offset, 0.0);
-  EXPECT_EQ(estimated.gnss.time_offset_sigma, 0.2);
+  EXPECT_TRUE(estimated.sensors.gnss.estimate_time_offset);
+  EXPECT_EQ(estimated.sensors.gnss.time_offset, 0.0);
+  EXPECT_EQ(estimated.sensors.gnss.time_offset_sigma, 0.2);
   EXPECT_NE(OptionsToYaml(estimated).find("  time_offset_s: estimate\n"), std::string::npos);
-  EXPECT_TRUE(Load(OptionsToYaml(estimated)).gnss.estimate_time_offset);
+  EXPECT_TRUE(Load(OptionsToYaml(estimated)).sensors.gnss.estimate_time_offset);
   EXPECT_NE(OptionsToYaml(held).find("  time_offset_s: 0.12\n"), std::string::npos);
   ExpectErrors({
       {"gnss: {time_offset_s: estimated}", {"gnss.time_offset_s: expected a number or 'estimate'", "estimated"}},

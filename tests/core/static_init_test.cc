@@ -37,7 +37,7 @@ struct InitRun {
 InitRun Feed(const SimOptions& sim, const Options& options) {
   const double g_norm = NormalGravity(sim.origin.lat_deg, sim.origin.alt_m);
   const LocalEnuFrame frame(sim.origin);
-  Initializer init(options, g_norm);
+  Initializer init(options.sensors, options.init, options.standstill, g_norm);
   Simulator simulator(sim);
   InitRun run;
   SimRecord rec;
@@ -47,7 +47,7 @@ InitRun Feed(const SimOptions& sim, const Options& options) {
         init.AddImu(rec.imu);
         break;
       case SimRecord::Type::kWheel: {
-        const WheelOptions& wo = options.wheel;
+        const WheelOptions& wo = options.sensors.wheel;
         WheelMeasurement w;
         w.t = rec.wheel.t;
         w.speed = 0.5 * (WheelSpeedFromPulses(rec.wheel.left_pulses, wo.radius, wo.pulses_per_rev, wo.interval) +
@@ -63,12 +63,13 @@ InitRun Feed(const SimOptions& sim, const Options& options) {
         GnssMeasurement m;
         m.t = g.t;
         m.p_w = frame.ToEnu({g.lat_deg, g.lon_deg, g.alt_m});
-        m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options.gnss.min_sigma) : options.gnss.sigma_enu;
+        const GnssOptions& go = options.sensors.gnss;
+        m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(go.min_sigma) : go.sigma_enu;
         m.heading_valid = g.heading_valid;
         m.yaw_G = CompassDegToEnuYaw(g.heading_deg);
-        m.sigma_yaw = options.gnss.heading_sigma;
+        m.sigma_yaw = go.heading_sigma;
         if (m.heading_valid) {
-          const Mat3 R_wG = rec.truth.R_wb() * ExpMat(Vec3(0, 0, options.gnss.mount_yaw));
+          const Mat3 R_wG = rec.truth.R_wb() * ExpMat(Vec3(0, 0, go.mount_yaw));
           run.heading_errors_deg.emplace_back(m.t, WrapAngle(m.yaw_G - YawOfXAxis<double>(R_wG)) * kRadToDeg);
         }
         init.AddGnss(m);
@@ -197,7 +198,7 @@ TEST(StaticInitializer, HeadingFromMotionWithoutDualAntenna) {
     SimOptions sim = test::TestDrive(seed);
     sim.heading_invalid_fraction = 1.0;
     Options options = test::TestRunOptions(sim);
-    options.gnss.use_heading = false;
+    options.sensors.gnss.use_heading = false;
     options.init.wait_for_heading = false;
     const InitRun run = Feed(sim, options);
     ASSERT_TRUE(run.done) << run.diagnosis;

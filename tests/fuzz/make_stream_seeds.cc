@@ -166,9 +166,7 @@ int ToLog(const std::string& input, const std::string& dir) {
   std::ifstream in(input, std::ios::binary);
   const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   StreamDecoder decoder(bytes.data(), bytes.size());
-  Options options;
-  static_cast<EstimatorOptions&>(options) = decoder.options();
-  std::ofstream(dir + "/config.yaml") << OptionsToYaml(options);
+  std::ofstream(dir + "/config.yaml") << OptionsToYaml(decoder.options());
   std::ofstream log(dir + "/log.txt");
   LogRecord r;
   size_t n = 0;

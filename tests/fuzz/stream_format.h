@@ -45,10 +45,10 @@
 #include <memory>
 #include <string>
 
+#include "config/options.h"
 #include "core/geodesy.h"
 #include "core/io/log_reader.h"
 #include "core/so3.h"
-#include "solver/estimator_options.h"
 
 namespace gins::fuzz {
 
@@ -121,7 +121,7 @@ class StreamDecoder {
  public:
   StreamDecoder(const uint8_t* data, size_t size);
 
-  const EstimatorOptions& options() const { return options_; }
+  const Options& options() const { return options_; }
   // The next record; false at the end of the input (or after kMaxRecords).
   bool Next(LogRecord* record);
 
@@ -144,7 +144,7 @@ class StreamDecoder {
   double Noise(double amplitude);
 
   ByteSource in_;
-  EstimatorOptions options_;
+  Options options_;
   GeodeticPoint base_;
   std::unique_ptr<LocalEnuFrame> base_frame_;
   double g_norm_ = kStandardGravity;
@@ -172,13 +172,13 @@ inline StreamDecoder::StreamDecoder(const uint8_t* data, size_t size) : in_(data
 
 inline void StreamDecoder::DecodeHeader() {
   const uint8_t h0 = in_.U8(), h1 = in_.U8(), h2 = in_.U8(), h3 = in_.U8();
-  EstimatorOptions& o = options_;
-  o.wheel.enabled = h0 & 1;
-  o.gnss.use_heading = h0 & 2;
+  Options& o = options_;
+  o.sensors.wheel.enabled = h0 & 1;
+  o.sensors.gnss.use_heading = h0 & 2;
   o.init.wait_for_heading = h0 & 4;
-  o.gnss.use_velocity = h0 & 8;
+  o.sensors.gnss.use_velocity = h0 & 8;
   o.standstill.enabled = h0 & 16;
-  o.vehicle.nonholonomic = h0 & 32;
+  o.sensors.vehicle.nonholonomic = h0 & 32;
   o.eskf.estimate_gravity = h0 & 64;
   o.watchdog.enabled = h0 & 128;
   o.smoother.window_size = 2 + (h1 & 3);
@@ -186,20 +186,20 @@ inline void StreamDecoder::DecodeHeader() {
   if (h1 & 16) o.smoother.linear_solver = "dense_schur";
   o.init.static_duration = (h1 & 32) ? 0.5 : 2.0;
   base_ = kBases[h3 & 7];
-  if (h1 & 64) o.gnss.origin = base_;
+  if (h1 & 64) o.sensors.gnss.origin = base_;
   if (h1 & 128) {  // the edges of what the config accepts
     o.smoother.min_keyframe_interval = 0.0;
     o.smoother.max_keyframe_interval = 0.2;
-    o.imu.max_gap = 0.05;
+    o.sensors.imu.max_gap = 0.05;
     o.watchdog.max_reject = 2.0;
     o.watchdog.max_position_sigma = 5.0;
   }
   switch ((h2 >> 6) & 3) {
     case 1:  // FRD
-      o.imu.R_b_imu = Vec3(1.0, -1.0, -1.0).asDiagonal();
+      o.sensors.imu.R_b_imu = Vec3(1.0, -1.0, -1.0).asDiagonal();
       break;
     case 2:  // RFU: body x = IMU y, body y = −IMU x
-      o.imu.R_b_imu << 0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 1.0;
+      o.sensors.imu.R_b_imu << 0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 1.0;
       break;
     default:
       break;
@@ -207,11 +207,11 @@ inline void StreamDecoder::DecodeHeader() {
   t_ = kStartTimes[h2 & 15];
   imu_dt_ = kImuDt[(h2 >> 4) & 3];
   grid_ = t_ - imu_dt_;
-  next_wheel_ = t_ + options_.wheel.interval;
+  next_wheel_ = t_ + options_.sensors.wheel.interval;
   next_fix_ = t_;
   base_frame_ = std::make_unique<LocalEnuFrame>(base_);
   g_norm_ = NormalGravity(base_.lat_deg, base_.alt_m);
-  last_imu_.acc = options_.imu.R_b_imu.transpose() * Vec3(0.0, 0.0, g_norm_);
+  last_imu_.acc = options_.sensors.imu.R_b_imu.transpose() * Vec3(0.0, 0.0, g_norm_);
 }
 
 inline bool StreamDecoder::Next(LogRecord* record) {
@@ -391,7 +391,7 @@ inline void StreamDecoder::VehicleSample(uint8_t sensors, double accel, double y
   const double gn = kNoiseGyro[noise_], an = kNoiseAcc[noise_];
   const Vec3 gyro_b(Noise(gn), Noise(gn), yaw_rate + Noise(gn));
   const Vec3 acc_b(a + Noise(an), car_.speed * yaw_rate + Noise(an), g_norm_ + Noise(an));
-  const Mat3 R_imu_b = options_.imu.R_b_imu.transpose();
+  const Mat3 R_imu_b = options_.sensors.imu.R_b_imu.transpose();
   last_imu_.gyro = (R_imu_b * gyro_b).cwiseMax(-log_limits::kMaxAbsGyro).cwiseMin(log_limits::kMaxAbsGyro);
   last_imu_.acc = (R_imu_b * acc_b).cwiseMax(-log_limits::kMaxAbsAcc).cwiseMin(log_limits::kMaxAbsAcc);
   const double imu_t = T + Noise(jitter_);
@@ -401,10 +401,10 @@ inline void StreamDecoder::VehicleSample(uint8_t sensors, double accel, double y
   const bool with_imu = !(mask_ & 1);
   // In time order: the jittered IMU stamp may fall before or after the other sensors' epoch T.
   if (with_imu && imu_t <= T) Emit(imu, imu_t);
-  if (next_wheel_ < T - options_.wheel.interval) next_wheel_ = T;  // after a gap: the next epoch is now
+  if (next_wheel_ < T - options_.sensors.wheel.interval) next_wheel_ = T;  // after a gap: the next epoch is now
   if (next_wheel_ <= T + 1e-9) {
     if ((sensors & 1) && !(mask_ & 2)) VehicleOdom(T);
-    next_wheel_ += options_.wheel.interval;
+    next_wheel_ += options_.sensors.wheel.interval;
   }
   if (next_fix_ < T - 1.0) next_fix_ = T;
   if (next_fix_ <= T + 1e-9) {
@@ -415,7 +415,7 @@ inline void StreamDecoder::VehicleSample(uint8_t sensors, double accel, double y
 }
 
 inline void StreamDecoder::VehicleOdom(double t) {
-  const WheelOptions& w = options_.wheel;
+  const WheelOptions& w = options_.sensors.wheel;
   if (wheel_fault_ == 1) return;  // silent
   double pulses = wheel_fault_ == 2 ? 0.0 : car_.speed * w.interval * w.pulses_per_rev / (2.0 * kPi * w.radius);
   if (wheel_fault_ == 3) pulses *= 2.0;
@@ -427,7 +427,7 @@ inline void StreamDecoder::VehicleOdom(double t) {
 
 inline void StreamDecoder::VehicleFix(double t, uint8_t sensors) {
   const Quat q = QuatFromYaw(car_.yaw);
-  GeodeticPoint g = base_frame_->ToGeodetic(car_.p + q * options_.gnss.lever_b + car_.jump);
+  GeodeticPoint g = base_frame_->ToGeodetic(car_.p + q * options_.sensors.gnss.lever_b + car_.jump);
   if (!Plausible(&g)) return;
   LogRecord r;
   r.type = LogRecord::Type::kGnss;
@@ -438,7 +438,8 @@ inline void StreamDecoder::VehicleFix(double t, uint8_t sensors) {
   r.gnss.sigma_enu = Vec3(0.02, 0.02, 0.03);
   r.gnss.heading_valid = (sensors & 4) && heading_fault_ != 2;
   if (r.gnss.heading_valid) {
-    double heading = EnuYawToCompassDeg(car_.yaw + options_.gnss.mount_yaw) + (heading_fault_ == 3 ? 180.0 : 0.0);
+    const double mount_yaw = options_.sensors.gnss.mount_yaw;
+    double heading = EnuYawToCompassDeg(car_.yaw + mount_yaw) + (heading_fault_ == 3 ? 180.0 : 0.0);
     if (heading_fault_ == 1) {
       if (frozen_heading_ < 0.0) frozen_heading_ = heading;
       heading = frozen_heading_;

@@ -17,6 +17,7 @@
 #include <memory>
 #include <string>
 
+#include "estimators_from_options.h"
 #include "fuzz/stream_format.h"
 #include "solver/eskf.h"
 #include "solver/estimator_pipeline.h"
@@ -81,7 +82,7 @@ struct StreamResult {
 inline StreamResult RunStream(const uint8_t* data, size_t size) {
   StreamResult result;
   StreamDecoder decoder(data, size);
-  const EstimatorOptions options = decoder.options();
+  const Options options = decoder.options();
   double first_t = -1.0, newest_t = 0.0;
   StreamChecker eskf("eskf", true, &first_t, &newest_t, &result.failure);
   StreamChecker final_states("smoother", true, &first_t, &newest_t, &result.failure);
@@ -92,9 +93,9 @@ inline StreamResult RunStream(const uint8_t* data, size_t size) {
       (*c)(e);
     };
   };
-  EstimatorPipeline session(options);
-  session.AddEstimator(std::make_unique<Eskf>(options, counted(&eskf)));
-  session.AddEstimator(std::make_unique<Smoother>(options, counted(&final_states), counted(&online)));
+  EstimatorPipeline session(options.sensors, options.init, options.standstill);
+  session.AddEstimator(test::MakeEskf(options, counted(&eskf)));
+  session.AddEstimator(test::MakeSmoother(options, counted(&final_states), counted(&online)));
   LogRecord r;
   while (decoder.Next(&r)) {
     if (first_t < 0.0) first_t = r.t();

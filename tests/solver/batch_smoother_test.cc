@@ -188,8 +188,8 @@ TEST(BatchEndToEnd, RevisitsTheWindowsFixDecisions) {
   sim.gyro_noise_density *= 4.0;
   sim.acc_noise_density *= 4.0;
   Options options = test::TestRunOptions(sim);
-  options.imu.gyro_noise_density = sim.gyro_noise_density / 4.0;  // the estimator told the quieter IMU
-  options.imu.acc_noise_density = sim.acc_noise_density / 4.0;
+  options.sensors.imu.gyro_noise_density = sim.gyro_noise_density / 4.0;  // the estimator told the quieter IMU
+  options.sensors.imu.acc_noise_density = sim.acc_noise_density / 4.0;
   const DriveRun clean = test::RunDriveThroughSession(sim, options, nullptr, false, true, true);
   sim.gnss_outlier_probability = 0.05;
   sim.gnss_outlier_magnitude = 20.0;
@@ -257,13 +257,13 @@ TEST(BatchEndToEnd, SigmaAgreesWithTheMonteCarloSpread) {
     sim.heading_invalid_fraction = 0.0;
     Options options = test::TestRunOptions(sim);
     // The estimator told the sensors' true noise.
-    options.imu.gyro_noise_density = sim.gyro_noise_density;
-    options.imu.acc_noise_density = sim.acc_noise_density;
-    options.imu.gyro_bias_rw = sim.gyro_bias_rw;
-    options.imu.acc_bias_rw = sim.acc_bias_rw;
-    options.gnss.heading_sigma = sim.heading_sigma;
-    options.wheel.enabled = false;  // the wheel and the vehicle models are not the simulator's noise
-    options.vehicle.nonholonomic = false;
+    options.sensors.imu.gyro_noise_density = sim.gyro_noise_density;
+    options.sensors.imu.acc_noise_density = sim.acc_noise_density;
+    options.sensors.imu.gyro_bias_rw = sim.gyro_bias_rw;
+    options.sensors.imu.acc_bias_rw = sim.acc_bias_rw;
+    options.sensors.gnss.heading_sigma = sim.heading_sigma;
+    options.sensors.wheel.enabled = false;  // the wheel and the vehicle models are not the simulator's noise
+    options.sensors.vehicle.nonholonomic = false;
     const DriveRun run = test::RunDriveThroughSession(sim, options, nullptr, false, true, true);
     ASSERT_TRUE(run.initialized);
     size_t j = 0;

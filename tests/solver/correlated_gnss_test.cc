@@ -40,14 +40,14 @@ void Score(const test::DriveRun& run, const std::vector<StateEstimate>& est, dou
 }
 
 Nees RunWith(const SimOptions& sim, double error_correlation) {
-  EstimatorOptions o = test::TestRunOptions(sim);
-  o.imu.gyro_noise_density = sim.gyro_noise_density;
-  o.imu.acc_noise_density = sim.acc_noise_density;
-  o.imu.gyro_bias_rw = sim.gyro_bias_rw;
-  o.imu.acc_bias_rw = sim.acc_bias_rw;
-  o.gnss.use_heading = false;
-  o.gnss.min_sigma = 0.3;
-  o.gnss.error_correlation = error_correlation;
+  Options o = test::TestRunOptions(sim);
+  o.sensors.imu.gyro_noise_density = sim.gyro_noise_density;
+  o.sensors.imu.acc_noise_density = sim.acc_noise_density;
+  o.sensors.imu.gyro_bias_rw = sim.gyro_bias_rw;
+  o.sensors.imu.acc_bias_rw = sim.acc_bias_rw;
+  o.sensors.gnss.use_heading = false;
+  o.sensors.gnss.min_sigma = 0.3;
+  o.sensors.gnss.error_correlation = error_correlation;
   const test::DriveRun run = test::RunDriveThroughSession(sim, o);
   EXPECT_TRUE(run.initialized);
   Nees r;

@@ -38,16 +38,16 @@ SimOptions TacticalDrive() {
   return s;
 }
 
-EstimatorOptions TacticalOptions(const SimOptions& sim, bool earth_rotation) {
-  EstimatorOptions o = test::TestRunOptions(sim);
+Options TacticalOptions(const SimOptions& sim, bool earth_rotation) {
+  Options o = test::TestRunOptions(sim);
   const double d = kDegToRad;
-  o.imu.gyro_noise_density = 0.05 * d / 60.0;
-  o.imu.acc_noise_density = 0.02 / 60.0;
-  o.imu.gyro_bias_rw = 0.1 * d / 3600.0 / 60.0;
-  o.imu.acc_bias_rw = 1e-4 / 60.0;
-  o.imu.init_gyro_bias_sigma = 2.0 * d / 3600.0;
-  o.imu.init_acc_bias_sigma = 1e-3;
-  o.gravity.earth_rotation = earth_rotation;
+  o.sensors.imu.gyro_noise_density = 0.05 * d / 60.0;
+  o.sensors.imu.acc_noise_density = 0.02 / 60.0;
+  o.sensors.imu.gyro_bias_rw = 0.1 * d / 3600.0 / 60.0;
+  o.sensors.imu.acc_bias_rw = 1e-4 / 60.0;
+  o.sensors.imu.init_gyro_bias_sigma = 2.0 * d / 3600.0;
+  o.sensors.imu.init_acc_bias_sigma = 1e-3;
+  o.sensors.gravity.earth_rotation = earth_rotation;
   return o;
 }
 

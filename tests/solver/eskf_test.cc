@@ -8,6 +8,7 @@
 #include "core/heading_model.h"
 #include "core/sim/simulator.h"
 #include "core/so3.h"
+#include "estimators_from_options.h"
 #include "solver/estimator_pipeline.h"
 #include "sim_feed.h"
 #include "test_scenarios.h"
@@ -34,8 +35,8 @@ bool InOutage(const SimOptions& sim, double t, double after) {
 
 DriveResult RunDrive(const SimOptions& sim, const Options& options) {
   Simulator simulator(sim);
-  EstimatorPipeline session(options);
-  auto eskf_owned = std::make_unique<Eskf>(options, nullptr);
+  EstimatorPipeline session(options.sensors, options.init, options.standstill);
+  auto eskf_owned = test::MakeEskf(options, nullptr);
   Eskf* eskf = eskf_owned.get();
   session.AddEstimator(std::move(eskf_owned));
 
@@ -109,12 +110,12 @@ TEST(EskfEndToEnd, SimulatedDriveConsistency) {
   for (unsigned seed : {3u, 4u, 5u}) {
     const SimOptions sim = test::TestDrive(seed);
     Options options = test::TestRunOptions(sim);
-    options.imu.gyro_noise_density = sim.gyro_noise_density;
-    options.imu.acc_noise_density = sim.acc_noise_density;
-    options.imu.gyro_bias_rw = sim.gyro_bias_rw;
-    options.imu.acc_bias_rw = sim.acc_bias_rw;
-    options.gnss.heading_sigma = sim.heading_sigma;
-    options.wheel.speed_sigma = sim.wheel_speed_noise;
+    options.sensors.imu.gyro_noise_density = sim.gyro_noise_density;
+    options.sensors.imu.acc_noise_density = sim.acc_noise_density;
+    options.sensors.imu.gyro_bias_rw = sim.gyro_bias_rw;
+    options.sensors.imu.acc_bias_rw = sim.acc_bias_rw;
+    options.sensors.gnss.heading_sigma = sim.heading_sigma;
+    options.sensors.wheel.speed_sigma = sim.wheel_speed_noise;
     const DriveResult r = RunDrive(sim, options);
     std::printf("seed %u: NEES %.2f over %d samples, rmse_h %.4f\n", seed, r.mean_nees, r.nees_samples, r.rmse_h);
     // Mean NEES of a 9-dof error over K independent samples is χ²(9K)/K. Samples 5 s apart still share
@@ -138,8 +139,8 @@ TEST(EskfEndToEnd, CovarianceIntervalMatchesPerSample) {
       options.eskf.covariance_interval = interval;
       std::vector<StateEstimate> states;
       Simulator simulator(sim);
-      EstimatorPipeline session(options);
-      session.AddEstimator(std::make_unique<Eskf>(options, [&](const StateEstimate& e) { states.push_back(e); }));
+      EstimatorPipeline session(options.sensors, options.init, options.standstill);
+      session.AddEstimator(test::MakeEskf(options, [&](const StateEstimate& e) { states.push_back(e); }));
       SimRecord rec;
       while (simulator.Next(&rec)) test::FeedSession(&session, rec);
       session.Finish();

@@ -30,10 +30,10 @@ TEST(MeasurementCounts, OfferedIsUsedPlusEveryRejection) {
 class FixResetTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    options_.gnss.lever_b = Vec3(-0.17, -0.20, 0.3);
-    options_.gnss.mount_yaw = 12.0 * kDegToRad;
-    options_.gnss.use_heading = true;
-    options_.vehicle.nonholonomic = true;
+    sensors_.gnss.lever_b = Vec3(-0.17, -0.20, 0.3);
+    sensors_.gnss.mount_yaw = 12.0 * kDegToRad;
+    sensors_.gnss.use_heading = true;
+    sensors_.vehicle.nonholonomic = true;
     // Level but for a small roll, yaw 0, the velocity of a minute ago along the body axis.
     x_.q_wb = Quat(Eigen::AngleAxisd(0.02, Vec3::UnitX()));
     x_.v_w = Vec3(5.0, 0.0, 0.0);
@@ -51,7 +51,8 @@ class FixResetTest : public ::testing::Test {
     return std::sqrt(z_b.dot(P.block<3, 3>(nav::kTheta, nav::kTheta) * z_b));
   }
   void LoseYaw(double sigma) { P_.block<3, 3>(nav::kTheta, nav::kTheta).diagonal() << 1e-4, 1e-4, sigma * sigma; }
-  EstimatorOptions options_;
+  SensorOptions sensors_;
+  WatchdogOptions watchdog_;
   NavState x_;
   MatX P_;
   GnssMeasurement fix_, prev_;
@@ -60,22 +61,22 @@ class FixResetTest : public ::testing::Test {
 TEST_F(FixResetTest, LostYawComesFromTheDualAntennaHeading) {
   LoseYaw(1.0);
   fix_.heading_valid = true;
-  fix_.yaw_G = 1.0 + options_.gnss.mount_yaw;
+  fix_.yaw_G = 1.0 + sensors_.gnss.mount_yaw;
   fix_.sigma_yaw = 0.2 * kDegToRad;
-  const FixReset r = ResetPositionFromFix(fix_, std::nullopt, options_, options_.watchdog, &x_, P_);
+  const FixReset r = ResetPositionFromFix(fix_, std::nullopt, sensors_, watchdog_, &x_, P_);
   EXPECT_STREQ(r.yaw, "heading");
   EXPECT_FALSE(r.velocity_from_fixes);
   EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 1.0, 1e-12);
   EXPECT_NEAR((x_.q_wb.conjugate() * Vec3::UnitZ()).y(), std::sin(0.02), 1e-12);  // the roll is kept
   EXPECT_NEAR(YawSigma(x_, P_), 2.0 * kDegToRad, 1e-9);  // the heading's σ, raised to the 2° floor
   EXPECT_LT((x_.v_w - Vec3(5.0 * std::cos(1.0), 5.0 * std::sin(1.0), 0.0)).norm(), 1e-12);  // turned with it
-  EXPECT_LT((x_.p_wb + x_.q_wb * options_.gnss.lever_b - fix_.p_w).norm(), 1e-12);  // the arm at the new yaw
+  EXPECT_LT((x_.p_wb + x_.q_wb * sensors_.gnss.lever_b - fix_.p_w).norm(), 1e-12);  // the arm at the new yaw
   EXPECT_TRUE(Eigen::SelfAdjointEigenSolver<MatX>(P_).eigenvalues().minCoeff() > 0.0);
 }
 
 TEST_F(FixResetTest, LostYawOfACarComesFromTheCourseOfTwoFixes) {
   LoseYaw(1.0);
-  const FixReset r = ResetPositionFromFix(fix_, prev_, options_, options_.watchdog, &x_, P_);
+  const FixReset r = ResetPositionFromFix(fix_, prev_, sensors_, watchdog_, &x_, P_);
   EXPECT_STREQ(r.yaw, "course");
   EXPECT_TRUE(r.velocity_from_fixes);
   EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 0.5 * M_PI, 1e-12);
@@ -85,7 +86,7 @@ TEST_F(FixResetTest, LostYawOfACarComesFromTheCourseOfTwoFixes) {
   LoseYaw(1.0);
   x_.q_wb = Quat::Identity();
   prev_.p_w = fix_.p_w - Vec3(0.0, 0.05, 0.0);
-  EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, options_, options_.watchdog, &x_, P_).yaw, "kept");
+  EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, sensors_, watchdog_, &x_, P_).yaw, "kept");
   EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 0.0, 1e-12);
 }
 
@@ -93,37 +94,37 @@ TEST_F(FixResetTest, AKnownYawIsKept) {
   LoseYaw(10.0 * kDegToRad);  // within 20°: the linearisation holds
   fix_.heading_valid = true;
   fix_.yaw_G = 1.0;
-  const FixReset r = ResetPositionFromFix(fix_, prev_, options_, options_.watchdog, &x_, P_);
+  const FixReset r = ResetPositionFromFix(fix_, prev_, sensors_, watchdog_, &x_, P_);
   EXPECT_STREQ(r.yaw, "kept");
   EXPECT_NEAR(YawOfXAxis<double>(x_.R_wb()), 0.0, 1e-12);
   EXPECT_NEAR(YawSigma(x_, P_), 10.0 * kDegToRad, 1e-4);  // about world up, the body rolled 0.02 rad
   // Lost, but not a car: the course says nothing of the yaw.
   LoseYaw(1.0);
-  options_.vehicle.nonholonomic = false;
+  sensors_.vehicle.nonholonomic = false;
   fix_.heading_valid = false;
-  EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, options_, options_.watchdog, &x_, P_).yaw, "kept");
+  EXPECT_STREQ(ResetPositionFromFix(fix_, prev_, sensors_, watchdog_, &x_, P_).yaw, "kept");
 }
 
 TEST_F(FixResetTest, WaitsForTheCourseOnlyWhenALaterFixCanGiveTheYaw) {
   LoseYaw(1.0);
-  EXPECT_TRUE(ResetWaitsForCourse(fix_, std::nullopt, options_, x_, P_));
+  EXPECT_TRUE(ResetWaitsForCourse(fix_, std::nullopt, sensors_, x_, P_));
   prev_.t = fix_.t - 60.0;  // the fix before the pause is too old for a course
-  EXPECT_TRUE(ResetWaitsForCourse(fix_, prev_, options_, x_, P_));
+  EXPECT_TRUE(ResetWaitsForCourse(fix_, prev_, sensors_, x_, P_));
   prev_.t = fix_.t - 1.0;  // a recent one gives it now
-  EXPECT_FALSE(ResetWaitsForCourse(fix_, prev_, options_, x_, P_));
+  EXPECT_FALSE(ResetWaitsForCourse(fix_, prev_, sensors_, x_, P_));
   GnssMeasurement slow = prev_;  // ... unless the car moved too little since for a course within ~20°
   slow.p_w = fix_.p_w - Vec3(0.0, 0.05, 0.0);
-  EXPECT_TRUE(ResetWaitsForCourse(fix_, slow, options_, x_, P_));
+  EXPECT_TRUE(ResetWaitsForCourse(fix_, slow, sensors_, x_, P_));
   GnssMeasurement with_heading = fix_;
   with_heading.heading_valid = true;
-  EXPECT_FALSE(ResetWaitsForCourse(with_heading, std::nullopt, options_, x_, P_));
-  options_.gnss.use_heading = false;  // a heading the config says not to use does not count
-  EXPECT_TRUE(ResetWaitsForCourse(with_heading, std::nullopt, options_, x_, P_));
-  options_.vehicle.nonholonomic = false;
-  EXPECT_FALSE(ResetWaitsForCourse(fix_, std::nullopt, options_, x_, P_));
-  options_.vehicle.nonholonomic = true;
+  EXPECT_FALSE(ResetWaitsForCourse(with_heading, std::nullopt, sensors_, x_, P_));
+  sensors_.gnss.use_heading = false;  // a heading the config says not to use does not count
+  EXPECT_TRUE(ResetWaitsForCourse(with_heading, std::nullopt, sensors_, x_, P_));
+  sensors_.vehicle.nonholonomic = false;
+  EXPECT_FALSE(ResetWaitsForCourse(fix_, std::nullopt, sensors_, x_, P_));
+  sensors_.vehicle.nonholonomic = true;
   LoseYaw(10.0 * kDegToRad);
-  EXPECT_FALSE(ResetWaitsForCourse(fix_, std::nullopt, options_, x_, P_));
+  EXPECT_FALSE(ResetWaitsForCourse(fix_, std::nullopt, sensors_, x_, P_));
 }
 
 // Metre-level fixes at 5 Hz: the held fix and the next are too close for a course; the wait goes on until
@@ -136,15 +137,15 @@ TEST_F(FixResetTest, WaitsOnUntilAFixGivesTheCourse) {
   for (const auto& [dt, wait] : {std::pair{0.2, true}, {0.4, true}, {0.8, false}}) {
     next.t = held.t + dt;
     next.p_w = held.p_w + Vec3(10.0 * dt, 0.0, 0.0);  // 10 m/s east; 3 σ of the course needs 0.42 s
-    EXPECT_EQ(ResetWaitsForCourse(next, held, options_, x_, P_, /*waiting=*/true), wait) << dt;
+    EXPECT_EQ(ResetWaitsForCourse(next, held, sensors_, x_, P_, /*waiting=*/true), wait) << dt;
   }
   next.t = held.t + 2.0;  // stopped: no course in 2 s; the reset keeps the yaw
   next.p_w = held.p_w;
-  EXPECT_FALSE(ResetWaitsForCourse(next, held, options_, x_, P_, /*waiting=*/true));
+  EXPECT_FALSE(ResetWaitsForCourse(next, held, sensors_, x_, P_, /*waiting=*/true));
   next.t = held.t + 1.9;
-  EXPECT_TRUE(ResetWaitsForCourse(next, held, options_, x_, P_, /*waiting=*/true));
+  EXPECT_TRUE(ResetWaitsForCourse(next, held, sensors_, x_, P_, /*waiting=*/true));
   next.heading_valid = true;  // a heading ends the wait
-  EXPECT_FALSE(ResetWaitsForCourse(next, held, options_, x_, P_, /*waiting=*/true));
+  EXPECT_FALSE(ResetWaitsForCourse(next, held, sensors_, x_, P_, /*waiting=*/true));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/sim/simulator.h"
+#include "estimators_from_options.h"
 #include "sim_feed.h"
 #include "solver/eskf.h"
 #include "solver/estimator_pipeline.h"
@@ -26,12 +27,12 @@ Streams RunDrive(bool parallel) {
   sim.segments.resize(8);  // 95 s
   const Options options = test::TestRunOptions(sim);
   Streams out;
-  EstimatorPipeline session(options);
+  EstimatorPipeline session(options.sensors, options.init, options.standstill);
   session.SetParallel(parallel);
-  session.AddEstimator(std::make_unique<Eskf>(
+  session.AddEstimator(test::MakeEskf(
       options, [&](const StateEstimate& e) { out.eskf.push_back(e); },
       [&](const StateEstimate& e) { out.eskf_rts.push_back(e); }));
-  session.AddEstimator(std::make_unique<Smoother>(
+  session.AddEstimator(test::MakeSmoother(
       options, [&](const StateEstimate& e) { out.smoother.push_back(e); },
       [&](const StateEstimate& e) { out.online.push_back(e); }, [&](const StateEstimate& e) { out.batch.push_back(e); }));
   Simulator simulator(sim);

@@ -9,6 +9,7 @@
 #include <tuple>
 #include <vector>
 
+#include "estimators_from_options.h"
 #include "fault_harness.h"
 
 namespace gins {
@@ -29,7 +30,7 @@ uint64_t Resets(const DriveRun& run, const char* estimator) {
 void ExpectOutageDriftAsWithoutWheels(const SimOptions& sim, const DriveRun& run, double outage, double outage_end,
                                       const char* fault) {
   Options no_wheels = test::TestRunOptions(sim);
-  no_wheels.wheel.enabled = false;
+  no_wheels.sensors.wheel.enabled = false;
   const DriveRun reference = test::RunDriveThroughSession(sim, no_wheels);
   ASSERT_TRUE(reference.initialized);
   for (const auto& [name, states, ref] : {std::tuple{"eskf", &run.eskf, &reference.eskf},
@@ -157,7 +158,7 @@ TEST(FaultInjection, LoggerPause) {
 TEST(FaultInjection, LongLoggerPauseWithoutHeading) {
   const SimOptions sim = FaultDrive(25, 140.0);
   Options options = test::TestRunOptions(sim);
-  options.gnss.use_heading = false;
+  options.sensors.gnss.use_heading = false;
   const double t0 = sim.start_time + 50.0, t1 = t0 + 60.0;
   std::vector<double> fixes;  // the times of the fixes the session got
   const DriveRun run = test::RunDriveThroughSession(sim, options, Editing([&](SimRecord* r) {
@@ -214,11 +215,11 @@ TEST(FaultInjection, LogEndsMidInitialisation) {
     const SimOptions sim = FaultDrive(26, 30.0);
     const Options options = test::TestRunOptions(sim);
     Simulator simulator(sim);
-    EstimatorPipeline session(options);
+    EstimatorPipeline session(options.sensors, options.init, options.standstill);
     size_t not_at_rest = 0;
     const StateCallback count = [&](const StateEstimate& s) { not_at_rest += !(s.x.v_w.isZero(0.0)); };
-    session.AddEstimator(std::make_unique<Eskf>(options, count));
-    session.AddEstimator(std::make_unique<Smoother>(options, count, count));
+    session.AddEstimator(test::MakeEskf(options, count));
+    session.AddEstimator(test::MakeSmoother(options, count, count));
     SimRecord r;
     while (simulator.Next(&r) && r.t() < sim.start_time + c.end) test::FeedSession(&session, r);
     ASSERT_FALSE(session.initialized());

@@ -128,7 +128,7 @@ TEST(FaultInjection, ImuDropoutRightAfterTheInitialisation) {
     for (double d : {0.05, 0.5, 1.5, 5.0, 30.0}) {
       const SimOptions sim = FaultDrive(19, 70.0);
       Options options = test::TestRunOptions(sim);
-      options.gnss.estimate_time_offset = estimate_offset;
+      options.sensors.gnss.estimate_time_offset = estimate_offset;
       const DriveRun run = test::RunDriveThroughSession(sim, options, ImuDropoutAfterInitialisation(d));
       SCOPED_TRACE("dropout " + std::to_string(d) + " s" + (estimate_offset ? ", offset estimated" : ""));
       ASSERT_TRUE(run.initialized);

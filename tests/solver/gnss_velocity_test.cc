@@ -18,9 +18,9 @@ SimOptions SinglePointDrive(unsigned seed) {
   return sim;
 }
 
-EstimatorOptions SinglePointOptions(const SimOptions& sim) {
-  EstimatorOptions o = test::TestRunOptions(sim);
-  o.gnss.min_sigma = 0.3;
+Options SinglePointOptions(const SimOptions& sim) {
+  Options o = test::TestRunOptions(sim);
+  o.sensors.gnss.min_sigma = 0.3;
   return o;
 }
 
@@ -44,7 +44,7 @@ test::RecordHook WithGvel(double sigma_v, const Vec3& lever_b) {
 
 TEST(GnssVelocity, ImprovesBothEstimatorsOnSinglePointFixes) {
   const SimOptions sim = SinglePointDrive(4);
-  const EstimatorOptions options = SinglePointOptions(sim);
+  const Options options = SinglePointOptions(sim);
   const test::DriveRun without = test::RunDriveThroughSession(sim, options);
   const test::DriveRun with = test::RunDriveThroughSession(sim, options, WithGvel(0.05, sim.lever_b));
   ASSERT_TRUE(without.initialized && with.initialized);

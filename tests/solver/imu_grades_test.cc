@@ -84,16 +84,16 @@ SimOptions GradeDrive(const Cell& c) {
 
 Options GradeOptions(const SimOptions& sim, const Cell& c) {
   Options o = test::TestRunOptions(sim);
-  o.imu.gyro_noise_density = sim.gyro_noise_density;
-  o.imu.acc_noise_density = sim.acc_noise_density;
-  o.imu.gyro_bias_rw = sim.gyro_bias_rw;
-  o.imu.acc_bias_rw = sim.acc_bias_rw;
-  o.imu.init_gyro_bias_sigma = 2.0 * c.grade.gyro_turn_on_deg_h * kDegToRad / 3600.0;
-  o.imu.init_acc_bias_sigma = 2.0 * c.grade.acc_turn_on_m_s2;
-  o.gnss.use_heading = c.aids == Aids::kWheelsAndHeading;
-  o.gnss.heading_sigma = sim.heading_sigma;
-  o.wheel.enabled = c.aids == Aids::kWheelsAndHeading;
-  o.wheel.speed_sigma = std::max(sim.wheel_speed_noise, 0.01);
+  o.sensors.imu.gyro_noise_density = sim.gyro_noise_density;
+  o.sensors.imu.acc_noise_density = sim.acc_noise_density;
+  o.sensors.imu.gyro_bias_rw = sim.gyro_bias_rw;
+  o.sensors.imu.acc_bias_rw = sim.acc_bias_rw;
+  o.sensors.imu.init_gyro_bias_sigma = 2.0 * c.grade.gyro_turn_on_deg_h * kDegToRad / 3600.0;
+  o.sensors.imu.init_acc_bias_sigma = 2.0 * c.grade.acc_turn_on_m_s2;
+  o.sensors.gnss.use_heading = c.aids == Aids::kWheelsAndHeading;
+  o.sensors.gnss.heading_sigma = sim.heading_sigma;
+  o.sensors.wheel.enabled = c.aids == Aids::kWheelsAndHeading;
+  o.sensors.wheel.speed_sigma = std::max(sim.wheel_speed_noise, 0.01);
   return o;
 }
 

@@ -33,10 +33,10 @@ SimOptions SppDrive(unsigned seed, double rate) {
   return s;
 }
 
-EstimatorOptions SppOptions(const SimOptions& sim) {
-  EstimatorOptions o = test::TestRunOptions(sim);
-  o.gnss.use_heading = false;
-  o.gnss.min_sigma = 0.3;
+Options SppOptions(const SimOptions& sim) {
+  Options o = test::TestRunOptions(sim);
+  o.sensors.gnss.use_heading = false;
+  o.sensors.gnss.min_sigma = 0.3;
   return o;
 }
 
@@ -56,7 +56,7 @@ struct Outcome {
 };
 
 // Runs the drive and scores both estimators from `score_from` s after initialisation on.
-Outcome RunAndScore(const SimOptions& sim, const EstimatorOptions& options, const char* name, double score_from = 30.0) {
+Outcome RunAndScore(const SimOptions& sim, const Options& options, const char* name, double score_from = 30.0) {
   Outcome o;
   o.run = test::RunDriveThroughSession(sim, options);
   EXPECT_TRUE(o.run.initialized) << name;
@@ -107,8 +107,8 @@ TEST(InitializationPaths, StaticWithWheelsAndHeading) {
 TEST(InitializationPaths, StaticWithWheelsNoHeading) {
   SimOptions sim = test::TestDrive(22);
   sim.heading_invalid_fraction = 1.0;
-  EstimatorOptions options = test::TestRunOptions(sim);
-  options.gnss.use_heading = false;
+  Options options = test::TestRunOptions(sim);
+  options.sensors.gnss.use_heading = false;
   const Outcome o = RunAndScore(sim, options, "static, wheels, no heading");
   const nlohmann::json& init = o.run.stats["initialization"];
   EXPECT_EQ(init["start"], "standstill");
@@ -127,7 +127,7 @@ TEST(InitializationPaths, StaticWithWheelsNoHeading) {
 // the yaw found later (within 4 of their σ); from the standstill's end to the initialisation, the fit's
 // window. Every state before the initialisation lies within 3 of its σ of the truth (95 % of them).
 // outlier_t: the fix at that time moved 20 m north (none if 0).
-void ExpectOutputFromTheFirstFix(const SimOptions& sim, const EstimatorOptions& options, const char* name,
+void ExpectOutputFromTheFirstFix(const SimOptions& sim, const Options& options, const char* name,
                                  double outlier_t = 0.0) {
   const test::RecordHook hook = [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline&) {
     if (r.type != SimRecord::Type::kGnss || std::abs(r.gnss.t - outlier_t) > 1e-6) return feed(r);
@@ -183,8 +183,8 @@ void ExpectOutputFromTheFirstFix(const SimOptions& sim, const EstimatorOptions& 
 TEST(InitializationPaths, AtRestWithoutHeadingEveryOutputFromTheFirstFix) {
   SimOptions sim = test::TestDrive(31);
   sim.heading_invalid_fraction = 1.0;
-  EstimatorOptions options = test::TestRunOptions(sim);
-  options.gnss.use_heading = false;
+  Options options = test::TestRunOptions(sim);
+  options.sensors.gnss.use_heading = false;
   ExpectOutputFromTheFirstFix(sim, options, "rest, wheels, no heading");
   // A gross outlier among the standstill's fixes (20 m north at 8 s) is not in its position.
   ExpectOutputFromTheFirstFix(sim, options, "rest, wheels, no heading, an outlier", sim.start_time + 8.0);
@@ -201,8 +201,8 @@ TEST(InitializationPaths, AtRestWithoutHeadingEveryOutputFromTheFirstFix) {
 TEST(InitializationPaths, AWindowThatDoesNotReachTheFirstFixEveryOutputFromTheFirstFix) {
   SimOptions sim = test::TestDrive(33);
   sim.heading_invalid_fraction = 1.0;
-  EstimatorOptions options = test::TestRunOptions(sim);
-  options.gnss.use_heading = false;
+  Options options = test::TestRunOptions(sim);
+  options.sensors.gnss.use_heading = false;
   const double drop0 = sim.start_time + 20.8, drop1 = drop0 + 0.6;
   const test::RecordHook hook = [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed,
                                     EstimatorPipeline&) {
@@ -285,8 +285,8 @@ TEST(InitializationPaths, InMotionSpp5HzFlatEarth) {
   SimOptions sim = SppDrive(26, 5.0);
   sim.log_start = 22.0;
   sim.earth_rotation = false;
-  EstimatorOptions options = SppOptions(sim);
-  options.gravity.earth_rotation = false;
+  Options options = SppOptions(sim);
+  options.sensors.gravity.earth_rotation = false;
   const Outcome o = RunAndScore(sim, options, "in motion, SPP 5 Hz, flat Earth");
   EXPECT_EQ(o.run.stats["initialization"]["start"], "moving");
   EXPECT_LT(o.init_after, 12.0);

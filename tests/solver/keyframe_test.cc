@@ -98,11 +98,11 @@ TEST(KeyframeBlocks, StateRoundTrip) {
 TEST(KeyframeStore, ScaleEstimatedOnlyWithWheelsAndEstimateScale) {
   for (bool wheels : {false, true}) {
     for (bool estimate : {false, true}) {
-      EstimatorOptions options;
-      options.wheel.enabled = wheels;
-      options.wheel.estimate_scale = estimate;
-      options.gnss.estimate_time_offset = false;  // TimeOffsetEstimatedOnlyWhenAskedForAndListedLast
-      KeyframeStore store(options);
+      SensorOptions sensors;
+      sensors.wheel.enabled = wheels;
+      sensors.wheel.estimate_scale = estimate;
+      sensors.gnss.estimate_time_offset = false;  // TimeOffsetEstimatedOnlyWhenAskedForAndListedLast
+      KeyframeStore store(sensors);
       const bool scale = wheels && estimate;
       EXPECT_EQ(store.estimated(BlockType::kScale), scale);
       for (BlockType type : kNavBlocks) EXPECT_TRUE(store.estimated(type));
@@ -127,9 +127,9 @@ TEST(KeyframeStore, ScaleEstimatedOnlyWithWheelsAndEstimateScale) {
 
 TEST(KeyframeStore, TimeOffsetEstimatedOnlyWhenAskedForAndListedLast) {
   for (bool estimate : {false, true}) {
-    EstimatorOptions options = test::WindowOptions(true);
-    options.gnss.estimate_time_offset = estimate;
-    const KeyframeStore store(options);
+    SensorOptions sensors = test::WindowSensors(true);
+    sensors.gnss.estimate_time_offset = estimate;
+    const KeyframeStore store(sensors);
     EXPECT_EQ(store.estimated(BlockType::kTimeOffset), estimate);
     const std::vector<BlockType> types = store.EstimatedTypes();
     EXPECT_EQ(types.back(), estimate ? BlockType::kTimeOffset : BlockType::kScale);
@@ -140,9 +140,9 @@ TEST(KeyframeStore, TimeOffsetEstimatedOnlyWhenAskedForAndListedLast) {
 
 TEST(KeyframeStore, KeptValuesStartTheNextWindow) {
   // A watchdog reset keeps what the window learnt of the sensors (scale, time offset) for its first keyframe.
-  EstimatorOptions options = test::WindowOptions(true);
-  options.gnss.estimate_time_offset = true;
-  KeyframeStore store(options);
+  SensorOptions sensors = test::WindowSensors(true);
+  sensors.gnss.estimate_time_offset = true;
+  KeyframeStore store(sensors);
   ceres::Problem problem(test::SmootherProblemOptions());
   store.Reset(&problem);
   std::mt19937 rng(3);
@@ -163,8 +163,8 @@ TEST(KeyframeStore, KeptValuesStartTheNextWindow) {
 }
 
 TEST(KeyframeStore, MakeCarriesBlocksOutsideNavStateAndListsInTimeThenTableOrder) {
-  const EstimatorOptions options = test::WindowOptions(true);
-  KeyframeStore store(options);
+  const SensorOptions sensors = test::WindowSensors(true);
+  KeyframeStore store(sensors);
   ceres::Problem problem(test::SmootherProblemOptions());
   store.Reset(&problem);
   std::mt19937 rng(2);
@@ -186,10 +186,10 @@ TEST(KeyframeStore, MakeCarriesBlocksOutsideNavStateAndListsInTimeThenTableOrder
 
 TEST(KeyframeStore, PriorReproducesTheCovariance) {
   for (bool estimate_scale : {false, true}) {
-    EstimatorOptions options = test::WindowOptions(estimate_scale);
-    options.gnss.estimate_time_offset = true;
-    options.gnss.time_offset_sigma = 0.05;
-    KeyframeStore store(options);
+    SensorOptions sensors = test::WindowSensors(estimate_scale);
+    sensors.gnss.estimate_time_offset = true;
+    sensors.gnss.time_offset_sigma = 0.05;
+    KeyframeStore store(sensors);
     ceres::Problem problem(test::SmootherProblemOptions());
     store.Reset(&problem);
     std::mt19937 rng(4);
@@ -213,7 +213,7 @@ TEST(KeyframeStore, PriorReproducesTheCovariance) {
         if (nav[i] >= 0 && nav[j] >= 0) {
           want = P0(nav[i], nav[j]);
         } else if (i == j) {  // the scale's or the time offset's own σ
-          const double sigma = i == P.rows() - 1 ? options.gnss.time_offset_sigma : options.wheel.scale_sigma;
+          const double sigma = i == P.rows() - 1 ? sensors.gnss.time_offset_sigma : sensors.wheel.scale_sigma;
           want = sigma * sigma;
         }
         EXPECT_NEAR(P(i, j), want, 1e-10) << i << "," << j;
@@ -223,7 +223,7 @@ TEST(KeyframeStore, PriorReproducesTheCovariance) {
 }
 
 TEST(KeyframeStore, FactorsLineariseAtTheFirstEstimatesOnceFrozen) {
-  KeyframeStore store(test::WindowOptions(true));
+  KeyframeStore store(test::WindowSensors(true));
   ceres::Problem problem(test::SmootherProblemOptions());
   store.Reset(&problem);
   std::mt19937 rng(6);
@@ -256,7 +256,7 @@ TEST(KeyframeStore, FactorsLineariseAtTheFirstEstimatesOnceFrozen) {
 
 TEST(KeyframeStore, RandomWalksFollowTheTable) {
   for (bool estimate_scale : {false, true}) {
-    KeyframeStore store(test::WindowOptions(estimate_scale));
+    KeyframeStore store(test::WindowSensors(estimate_scale));
     ceres::Problem problem(test::SmootherProblemOptions());
     store.Reset(&problem);
     std::mt19937 rng(8);

@@ -95,8 +95,8 @@ TEST(FillBackward, TheReversedMechanisationRetracesTheTruth) {
   std::mt19937 rng(1);
   span.fixes.push_back(FixAt(d.truth[i_s - 4000], Vec3::Zero(), Vec3::Constant(1e3), &rng));  // σ 1 km: says nothing
   span.from = t0;
-  EstimatorOptions options = test::TestRunOptions(sim);
-  const std::vector<StateEstimate> out = FillBackward(options, span);
+  Options options = test::TestRunOptions(sim);
+  const std::vector<StateEstimate> out = FillBackward(options.sensors, options.eskf, options.standstill, span);
   ASSERT_GT(out.size(), 3900u);
   EXPECT_NEAR(out.front().x.t, t0, 1e-6);
   EXPECT_LT(out.back().x.t, t_s);
@@ -126,7 +126,7 @@ TEST(FillBackward, FixesAndStandstillsPinTheStatesBeforeTheStart) {
   const SimOptions sim = test::TestDrive(42);
   const double t_s = sim.start_time + 40.0;
   const Drive d = Simulate(sim, t_s, Vec3::Zero());
-  const EstimatorOptions options = test::TestRunOptions(sim);
+  const Options options = test::TestRunOptions(sim);
   BackwardSpan span;
   span.earth = d.earth;
   size_t i_s = 0;
@@ -137,14 +137,15 @@ TEST(FillBackward, FixesAndStandstillsPinTheStatesBeforeTheStart) {
       break;
     }
     span.imu.push_back(d.imu[i]);
-    if (i % 100 == 50) span.fixes.push_back(FixAt(d.truth[i], options.gnss.lever_b, sim.gnss_sigma_enu, &rng));
+    if (i % 100 == 50) span.fixes.push_back(FixAt(d.truth[i], options.sensors.gnss.lever_b, sim.gnss_sigma_enu, &rng));
   }
   ASSERT_GT(i_s, 0u);
   span.rests.push_back({sim.start_time, sim.start_time + 19.5});
   span.from = span.fixes.front().t;
   span.start = EstimateAt(d.truth[i_s], 0.02, 0.01, 0.05 * kDegToRad);
-  span.P = CovarianceAt(0.02, 0.01, 0.05 * kDegToRad, options.imu.init_gyro_bias_sigma, options.imu.init_acc_bias_sigma);
-  const std::vector<StateEstimate> out = FillBackward(options, span);
+  const ImuOptions& imu = options.sensors.imu;
+  span.P = CovarianceAt(0.02, 0.01, 0.05 * kDegToRad, imu.init_gyro_bias_sigma, imu.init_acc_bias_sigma);
+  const std::vector<StateEstimate> out = FillBackward(options.sensors, options.eskf, options.standstill, span);
   ASSERT_FALSE(out.empty());
   EXPECT_NEAR(out.front().x.t, span.from, 1e-6);
   size_t n = 0, within = 0;
@@ -176,11 +177,11 @@ TEST(FillBackward, NothingWithoutAFixBeforeTheStart) {
   BackwardSpan span;
   span.start.x.t = 10.0;
   span.imu.push_back(ImuSample{9.0, Vec3::Zero(), Vec3(0.0, 0.0, kStandardGravity)});
-  EXPECT_TRUE(FillBackward(EstimatorOptions(), span).empty());
+  EXPECT_TRUE(FillBackward(SensorOptions(), EskfOptions(), StandstillOptions(), span).empty());
   GnssMeasurement f;
   f.t = 10.0;
   span.fixes.push_back(f);
-  EXPECT_TRUE(FillBackward(EstimatorOptions(), span).empty());
+  EXPECT_TRUE(FillBackward(SensorOptions(), EskfOptions(), StandstillOptions(), span).empty());
 }
 
 }  // namespace

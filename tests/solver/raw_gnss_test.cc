@@ -81,12 +81,12 @@ SimOptions RawDrive(unsigned seed) {
   return sim;
 }
 
-EstimatorOptions RawOptions(const SimOptions& sim) {
-  EstimatorOptions o = test::TestRunOptions(sim);
-  o.wheel.enabled = false;
-  o.wheel.interval = 0.1;  // TestRunOptions' 1/wheel_rate: no wheels here
-  o.gnss.use_heading = false;
-  o.gravity.earth_rotation = true;
+Options RawOptions(const SimOptions& sim) {
+  Options o = test::TestRunOptions(sim);
+  o.sensors.wheel.enabled = false;
+  o.sensors.wheel.interval = 0.1;  // TestRunOptions' 1/wheel_rate: no wheels here
+  o.sensors.gnss.use_heading = false;
+  o.sensors.gravity.earth_rotation = true;
   return o;
 }
 
@@ -153,7 +153,7 @@ test::RecordHook WithRawEpochs(const SimOptions& sim, const RawGnssSimOptions& r
 
 TEST(RawGnss, TightlyCoupledDriveWithoutFixes) {
   const SimOptions sim = RawDrive(31);
-  const EstimatorOptions options = RawOptions(sim);
+  const Options options = RawOptions(sim);
   const test::DriveRun run = test::RunDriveThroughSession(sim, options, WithRawEpochs(sim, RawSim(), false));
   ASSERT_TRUE(run.initialized);
   const double from = run.init_t + 20.0;
@@ -184,7 +184,7 @@ TEST(RawGnss, TightlyCoupledDriveWithoutFixes) {
 
 TEST(RawGnss, UrbanCanyonDriftsFarLessTightlyThanLoosely) {
   const SimOptions sim = RawDrive(32);
-  const EstimatorOptions options = RawOptions(sim);
+  const Options options = RawOptions(sim);
   RawGnssSimOptions raw = RawSim();
   // 60 s with the 3 highest satellites only, from 120 s into the drive (the cruise and the long turn).
   raw.blocked = {{119.0, 60.0, 3}};

@@ -13,6 +13,7 @@
 
 #include "core/geodesy.h"
 #include "core/sim/simulator.h"
+#include "estimators_from_options.h"
 #include "fault_harness.h"
 #include "solver/eskf.h"
 #include "solver/estimator_pipeline.h"
@@ -49,9 +50,9 @@ struct Output {
 Output RunDrive(const SimOptions& sim, const Options& options, const Edit& edit) {
   Output out;
   Simulator simulator(sim);
-  EstimatorPipeline session(options);
-  auto eskf = std::make_unique<Eskf>(options, [&](const StateEstimate& e) { out.eskf.push_back(e); });
-  auto smoother = std::make_unique<Smoother>(
+  EstimatorPipeline session(options.sensors, options.init, options.standstill);
+  auto eskf = test::MakeEskf(options, [&](const StateEstimate& e) { out.eskf.push_back(e); });
+  auto smoother = test::MakeSmoother(
       options, [&](const StateEstimate& e) { out.smoother.push_back(e); }, nullptr);
   const Eskf* eskf_ptr = eskf.get();
   const Smoother* smoother_ptr = smoother.get();
@@ -230,7 +231,7 @@ TEST(RobustnessEndToEnd, WatchdogResetsWhenThePositionCovarianceExplodes) {
   SimOptions sim = Shortened(test::TestDrive(6), 175.0);
   sim.gnss_outages = {{110.0, 40.0}};
   Options options = test::TestRunOptions(sim);
-  options.wheel.enabled = false;
+  options.sensors.wheel.enabled = false;
   options.watchdog.max_position_sigma = 1.0;
   const Output out = RunDrive(sim, options, nullptr);
   const double outage_end = sim.start_time + 150.0;
@@ -272,7 +273,7 @@ TEST(RobustnessEndToEnd, ParkedVehicleDoesNotWanderInEitherEstimator) {
   for (bool wheels : {true, false}) {
     SCOPED_TRACE(wheels ? "with wheels" : "without wheels");
     Options options = test::TestRunOptions(sim);
-    options.wheel.enabled = wheels;
+    options.sensors.wheel.enabled = wheels;
     const Output out = RunDrive(sim, options, nullptr);
     // Over 60 s of the stop, all without GNSS.
     const double t0 = stop_start + 3.0, t1 = t0 + 60.0;

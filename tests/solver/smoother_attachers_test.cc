@@ -21,9 +21,8 @@ class AttacherTest : public ::testing::Test {
  protected:
   AttacherTest()
       : problem_(test::SmootherProblemOptions()),
-        store_(options_),
+        store_(sensors_),
         context_{store_,
-                 options_,
                  earth_,
                  last_imu_,
                  [this](double t) { return Predict(t); },
@@ -31,8 +30,8 @@ class AttacherTest : public ::testing::Test {
                  [this]() -> const MatX* { return two_.size() > 0 ? &two_ : nullptr; },
                  [this](double t) { return Anchor(t); },
                  [this](double t) { return Predict(t).x; }} {
-    options_.gnss.lever_b = Vec3::Zero();
-    options_.wheel.lever_b = Vec3::Zero();
+    sensors_.gnss.lever_b = Vec3::Zero();
+    sensors_.wheel.lever_b = Vec3::Zero();
     store_.Reset(&problem_);
   }
   // A keyframe at t, level with yaw 0 (body x east), moving at `speed` along x from x = 10·t.
@@ -77,7 +76,8 @@ class AttacherTest : public ::testing::Test {
     return j;
   }
 
-  EstimatorOptions options_ = test::WindowOptions(true);
+  SensorOptions sensors_ = test::WindowSensors(true);
+  StandstillOptions standstill_options_;
   ceres::Problem problem_;
   KeyframeStore store_;
   EarthModel earth_ = EarthModel(9.81);
@@ -99,7 +99,7 @@ GnssMeasurement Fix(double t, const Vec3& p_w) {
 TEST_F(AttacherTest, GnssFixIsCheckedAgainstThePredictionAndAttachedAtItsEpoch) {
   Push(10.0, 10.0);  // at (100, 0, 0), σ_p 5 cm
   std::vector<std::pair<double, bool>> outcomes;
-  GnssAttacher gnss(options_.gnss, [&](double t, bool ok) { outcomes.emplace_back(t, ok); }, [](double) {});
+  GnssAttacher gnss(sensors_.gnss, [&](double t, bool ok) { outcomes.emplace_back(t, ok); }, [](double) {});
   // 10 cm off: innovation χ² ≈ 0.1²/(0.05² + 0.02²) ≈ 3.4: accepted, at full weight.
   EXPECT_TRUE(gnss.On(Fix(10.0, Vec3(100.1, 0.0, 0.0)), context_));
   EXPECT_EQ(Residuals(), 1);
@@ -124,7 +124,7 @@ TEST_F(AttacherTest, AgreeingRejectedFixesReacquire) {
   Push(0.0, 10.0);
   sigma_p_ = 0.02;
   std::vector<double> reacquired;
-  GnssAttacher gnss(options_.gnss, [](double, bool) {}, [&](double f) { reacquired.push_back(f); });
+  GnssAttacher gnss(sensors_.gnss, [](double, bool) {}, [&](double f) { reacquired.push_back(f); });
   // The estimate is 0.5 m off (an overconfident window after an outage): every fix agrees with the next.
   int accepted_at = -1;
   for (int k = 0; k < 10 && accepted_at < 0; ++k) {
@@ -140,7 +140,7 @@ TEST_F(AttacherTest, AgreeingRejectedFixesReacquire) {
 TEST_F(AttacherTest, ScatteredOutliersDoNotReacquire) {
   Push(0.0, 10.0);
   sigma_p_ = 0.02;
-  GnssAttacher gnss(options_.gnss, [](double, bool) {}, [](double) {});
+  GnssAttacher gnss(sensors_.gnss, [](double, bool) {}, [](double) {});
   // 20 m outliers in directions that change every time: never a run that agrees.
   for (int k = 0; k < 12; ++k) {
     const double a = 2.1 * k;
@@ -151,8 +151,8 @@ TEST_F(AttacherTest, ScatteredOutliersDoNotReacquire) {
 }
 
 TEST_F(AttacherTest, StandstillIsCheckedAgainstThePredictedVelocity) {
-  options_.standstill.max_speed = 0.5;
-  StandstillAttacher standstill(options_.standstill, options_.imu, options_.wheel.gate_probability);
+  standstill_options_.max_speed = 0.5;
+  StandstillAttacher standstill(standstill_options_, sensors_.imu, sensors_.wheel.gate_probability);
   Keyframe& a = Push(20.0, 0.01);
   standstill.On({20.0, 18.0}, context_);
   EXPECT_EQ(Residuals(), 1);  // the zero velocity
@@ -180,7 +180,7 @@ TEST_F(AttacherTest, StandstillIsCheckedAgainstThePredictedVelocity) {
 // 0.5 s (0.04 deg/s) allow far less. The zero motion joins the keyframes with its rotation free, and the
 // outputs between them are not held still.
 TEST_F(AttacherTest, StandingButTurningKeepsTheRotationFree) {
-  StandstillAttacher standstill(options_.standstill, options_.imu, options_.wheel.gate_probability);
+  StandstillAttacher standstill(standstill_options_, sensors_.imu, sensors_.wheel.gate_probability);
   Push(20.0, 0.0);
   standstill.On({20.0, 18.0}, context_);
   Keyframe& b = Push(20.5, 0.0);
@@ -205,9 +205,9 @@ WheelMeasurement Wheel(double t, double speed) {
 }
 
 TEST_F(AttacherTest, OdometerIntegratesEveryRecordAndSplitsTheOneAcrossAKeyframe) {
-  VehicleAttacher vehicle(options_);
-  options_.vehicle.nonholonomic = false;
-  VehicleAttacher odometer_only(options_);
+  VehicleAttacher vehicle(sensors_);
+  sensors_.vehicle.nonholonomic = false;
+  VehicleAttacher odometer_only(sensors_);
   // Keyframes at 0, 1 and 2 s; records every 0.1 s from 0.05 s, so the record at 1.05 s straddles 1.0 s.
   Keyframe& k0 = Push(0.0, 10.0);
   odometer_only.OnKeyframeCreated(k0, context_);
@@ -232,8 +232,8 @@ TEST_F(AttacherTest, OdometerIntegratesEveryRecordAndSplitsTheOneAcrossAKeyframe
 }
 
 TEST_F(AttacherTest, NonHolonomicConstraintAtEachKeyframeWithOrWithoutWheels) {
-  options_.wheel.enabled = false;
-  VehicleAttacher vehicle(options_);
+  sensors_.wheel.enabled = false;
+  VehicleAttacher vehicle(sensors_);
   Keyframe& k0 = Push(0.0, 10.0);
   vehicle.OnKeyframeCreated(k0, context_);
   EXPECT_EQ(Residuals(), 1);  // the NHC at k0
@@ -259,8 +259,8 @@ TEST_F(AttacherTest, NonHolonomicConstraintAtEachKeyframeWithOrWithoutWheels) {
 // The chord between two keyframes is checked across the path the IMU traced (OnImuStep): entering a left turn
 // while speeding up, it is used; against a path that went straight on, the same keyframes are rejected.
 TEST_F(AttacherTest, ChordFollowsThePathTheImuTraced) {
-  options_.wheel.enabled = false;
-  VehicleAttacher turned(options_), straight(options_);
+  sensors_.wheel.enabled = false;
+  VehicleAttacher turned(sensors_), straight(sensors_);
   Keyframe& k0 = Push(0.0, 8.0);
   turned.OnKeyframeCreated(k0, context_);
   straight.OnKeyframeCreated(k0, context_);

@@ -14,12 +14,12 @@ namespace gins {
 namespace {
 
 TEST(PredictBlockCovariance, BlocksOutsideNavStateAreRandomWalksOfTheirOwnSigma) {
-  EstimatorOptions options;
-  options.wheel.enabled = true;
-  options.wheel.estimate_scale = true;
-  options.wheel.scale_rw = 2e-4;
-  options.gnss.estimate_time_offset = true;
-  options.gnss.time_offset_rw = 3e-3;
+  SensorOptions sensors;
+  sensors.wheel.enabled = true;
+  sensors.wheel.estimate_scale = true;
+  sensors.wheel.scale_rw = 2e-4;
+  sensors.gnss.estimate_time_offset = true;
+  sensors.gnss.time_offset_rw = 3e-3;
   NavState x;
   x.q_wb = ExpQuat<double>(Vec3(0.05, -0.02, 1.0));
   x.v_w = Vec3(8.0, 1.0, 0.0);
@@ -33,8 +33,8 @@ TEST(PredictBlockCovariance, BlocksOutsideNavStateAreRandomWalksOfTheirOwnSigma)
   const int n = 17;  // 15 + scale + offset
   MatX cov_i = MatX::Identity(n, n) * 1e-2;
   cov_i(15, 16) = cov_i(16, 15) = 4e-3;  // scale and offset correlated at i: kept
-  const MatX predicted = PredictBlockCovariance(all, cov_i, x, pre, options);
-  const MatX nav_only = PredictBlockCovariance(nav, MatX(cov_i.topLeftCorner(15, 15)), x, pre, options);
+  const MatX predicted = PredictBlockCovariance(all, cov_i, x, pre, sensors);
+  const MatX nav_only = PredictBlockCovariance(nav, MatX(cov_i.topLeftCorner(15, 15)), x, pre, sensors);
   ASSERT_EQ(predicted.rows(), n);
   EXPECT_LT((predicted.topLeftCorner(15, 15) - nav_only).cwiseAbs().maxCoeff(),
             1e-12 * nav_only.cwiseAbs().maxCoeff());

@@ -13,6 +13,7 @@
 
 #include "core/sim/simulator.h"
 #include "core/so3.h"
+#include "estimators_from_options.h"
 #include "solver/eskf.h"
 #include "solver/estimator_pipeline.h"
 #include "sim_feed.h"
@@ -113,11 +114,11 @@ struct DriveOutput {
 DriveOutput RunDrive(const SimOptions& sim, const Options& options, bool with_eskf) {
   DriveOutput out;
   Simulator simulator(sim);
-  EstimatorPipeline session(options);
+  EstimatorPipeline session(options.sensors, options.init, options.standstill);
   if (with_eskf) {
-    session.AddEstimator(std::make_unique<Eskf>(options, [&](const StateEstimate& e) { out.eskf.push_back(e); }));
+    session.AddEstimator(test::MakeEskf(options, [&](const StateEstimate& e) { out.eskf.push_back(e); }));
   }
-  auto smoother_owned = std::make_unique<Smoother>(
+  auto smoother_owned = test::MakeSmoother(
       options, [&](const StateEstimate& e) { out.smoother_final.push_back(e); },
       [&](const StateEstimate& e) { out.smoother_online.push_back(e); });
   const Smoother* smoother = smoother_owned.get();

@@ -82,11 +82,11 @@ TEST(VehicleSetups, ImuAheadOfTheRearAxleHasNoHeadingBiasInTurns) {
   sim.wheel_lever_b = Vec3(-1.5, 0.0, -0.4);
   sim.gnss_outages.clear();
   Options options = test::TestRunOptions(sim);
-  options.gnss.use_heading = false;
-  options.vehicle.nonholonomic = true;
+  options.sensors.gnss.use_heading = false;
+  options.sensors.vehicle.nonholonomic = true;
   for (const bool modelled : {true, false}) {
     SCOPED_TRACE(modelled ? "wheel.lever_arm_m set" : "wheel.lever_arm_m left at zero");
-    options.wheel.lever_b = modelled ? sim.wheel_lever_b : Vec3::Zero();
+    options.sensors.wheel.lever_b = modelled ? sim.wheel_lever_b : Vec3::Zero();
     const DriveRun run = test::RunDriveThroughSession(sim, options);
     ASSERT_TRUE(run.initialized);
     for (const auto& [name, states] : {std::pair{"eskf", &run.eskf}, std::pair{"smoother", &run.smoother}}) {

@@ -29,12 +29,12 @@ inline ceres::Problem::Options SmootherProblemOptions() {
   return po;
 }
 
-inline EstimatorOptions WindowOptions(bool estimate_scale) {
-  EstimatorOptions options;
-  options.wheel.enabled = true;
-  options.wheel.estimate_scale = estimate_scale;
-  options.gnss.estimate_time_offset = false;  // the window's tests of it set it
-  return options;
+inline SensorOptions WindowSensors(bool estimate_scale) {
+  SensorOptions sensors;
+  sensors.wheel.enabled = true;
+  sensors.wheel.estimate_scale = estimate_scale;
+  sensors.gnss.estimate_time_offset = false;  // the window's tests of it set it
+  return sensors;
 }
 
 // Dense Jacobian (tangent columns) of `residuals` (all when empty) over `blocks`, and the residual.
@@ -60,9 +60,9 @@ inline MatX DenseJacobian(ceres::Problem* problem, const std::vector<double*>& b
 class TestWindow {
  public:
   TestWindow(int n, bool estimate_scale)
-      : options(WindowOptions(estimate_scale)),
+      : sensors(WindowSensors(estimate_scale)),
         problem(std::make_unique<ceres::Problem>(SmootherProblemOptions())),
-        store(options),
+        store(sensors),
         loss(std::make_unique<ceres::CauchyLoss>(1.0)) {
     store.Reset(problem.get());
     std::mt19937 rng(11);
@@ -113,7 +113,7 @@ class TestWindow {
   }
 
   const Vec3 g_w = GravityWorld(9.81);
-  EstimatorOptions options;
+  SensorOptions sensors;
   std::unique_ptr<ceres::Problem> problem;
   KeyframeStore store;
   std::unique_ptr<ceres::LossFunction> loss;

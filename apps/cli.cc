@@ -222,9 +222,10 @@ int RunCli(int argc, const char* const* argv, bool own_process) {
       const SimulationResult r = Simulate(options.simulate, sim_out);
       std::printf("gins simulate: %.1f s, %llu IMU, %llu GNSS, %llu GVEL, %llu ODOM records -> %s/log.txt, "
                   "%s/truth.csv\n",
-                  r.duration, static_cast<unsigned long long>(r.imu), static_cast<unsigned long long>(r.gnss),
-                  static_cast<unsigned long long>(r.gnss_velocity), static_cast<unsigned long long>(r.wheel), sim_out.c_str(),
-                  sim_out.c_str());
+                  r.duration, static_cast<unsigned long long>(CountOf<ImuSample>(r.records)),
+                  static_cast<unsigned long long>(CountOf<GnssRecord>(r.records)),
+                  static_cast<unsigned long long>(CountOf<GnssVelocityRecord>(r.records)),
+                  static_cast<unsigned long long>(CountOf<WheelRecord>(r.records)), sim_out.c_str(), sim_out.c_str());
       return 0;
     }
   } catch (const std::exception& e) {

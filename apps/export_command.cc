@@ -84,7 +84,7 @@ void AddRunMarkers(const nlohmann::json& summary, const std::string& stream, Geo
     LogReader reader(summary["log"].get<std::string>(), InputOptions{});
     LogRecord r;
     while (reader.Next(&r)) {
-      if (r.type == LogRecord::Type::kGnss) fixes.push_back(r.gnss);
+      if (const GnssRecord* fix = r.get_if<GnssRecord>()) fixes.push_back(*fix);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gins export: the rejected fixes are not marked: %s\n", e.what());

@@ -99,7 +99,8 @@ nlohmann::json InputJson(const ReadStats& rs, const EstimatorPipeline& session, 
                          const api::Status& status) {
   nlohmann::json input;
   input["lines"] = rs.lines;
-  input["records"] = {{"imu", rs.imu}, {"odom", rs.wheel}, {"gnss", rs.gnss}, {"gvel", rs.gnss_velocity}};
+  input["records"] = nlohmann::json::object();
+  for (size_t k = 0; k < kNumRecordTypes; ++k) input["records"][kRecordTypes[k].count_key] = rs.records[k];
   input["skipped"] = nlohmann::json::object();
   for (const auto& [k, v] : rs.skipped) input["skipped"][k] = v;
   input["skipped_examples"] = nlohmann::json::array();
@@ -272,9 +273,7 @@ void CheckReadCounts(const std::string& name, const ReadStats& rs, bool raw_gnss
   auto no_usable = [&](const std::string& what) {
     if (rs.lines == 0) return RunError(name + ": empty log (no lines)");
     std::string m = name + ": no usable " + what + " records (" + std::to_string(rs.lines) + " lines: " +
-                    std::to_string(rs.imu) + " IMU, " + std::to_string(rs.wheel) + " ODOM, " +
-                    std::to_string(rs.gnss) + " GNSS, " +
-                    (rs.gnss_velocity > 0 ? std::to_string(rs.gnss_velocity) + " GVEL, " : std::string()) +
+                    FormatRecordCounts(rs.records, ZeroCounts::kHideQuiet) + ", " +
                     std::to_string(rs.total_skipped()) + " damaged";
     if (!rs.examples.empty()) {
       m += "; first: line " + std::to_string(rs.examples.front().line) + ": " + rs.examples.front().reason + ": " +
@@ -282,8 +281,8 @@ void CheckReadCounts(const std::string& name, const ReadStats& rs, bool raw_gnss
     }
     return RunError(m + ")");
   };
-  if (rs.imu == 0) throw no_usable("IMU");
-  if (rs.gnss == 0 && !raw_gnss) throw no_usable("GNSS");
+  if (CountOf<ImuSample>(rs.records) == 0) throw no_usable("IMU");
+  if (CountOf<GnssRecord>(rs.records) == 0 && !raw_gnss) throw no_usable("GNSS");
 }
 
 void FinishSession(const std::string& name, api::Session* session) {

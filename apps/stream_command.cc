@@ -134,11 +134,9 @@ void Report(const ReadStats& rs, const StateLines& lines, api::Stream stream, in
   for (const auto& [reason, n] : rs.skipped) skipped += " " + reason + " " + std::to_string(n);
   std::fprintf(
       stderr,
-      "gins stream: %llu lines: %llu IMU, %llu ODOM, %llu GNSS, %llu GVEL records; %llu damaged lines "
-      "skipped%s%s; %llu %s states written%s%s\n",
-      static_cast<unsigned long long>(rs.lines), static_cast<unsigned long long>(rs.imu),
-      static_cast<unsigned long long>(rs.wheel), static_cast<unsigned long long>(rs.gnss),
-      static_cast<unsigned long long>(rs.gnss_velocity), static_cast<unsigned long long>(rs.total_skipped()),
+      "gins stream: %llu lines: %s records; %llu damaged lines skipped%s%s; %llu %s states written%s%s\n",
+      static_cast<unsigned long long>(rs.lines), FormatRecordCounts(rs.records, ZeroCounts::kShow).c_str(),
+      static_cast<unsigned long long>(rs.total_skipped()),
       skipped.empty() ? "" : " (", skipped.empty() ? "" : (skipped.substr(1) + ")").c_str(),
       static_cast<unsigned long long>(lines.written()), api::StreamName(stream),
       lines.non_finite() > 0 ? (", " + std::to_string(lines.non_finite()) + " not finite skipped").c_str() : "",

@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -207,16 +208,14 @@ class EstimatorPipeline {
 };
 
 inline void EstimatorPipeline::Add(const LogRecord& r) {
-  switch (r.type) {
-    case LogRecord::Type::kImu:
-      return AddImu(r.imu);
-    case LogRecord::Type::kWheel:
-      return AddWheel(r.wheel);
-    case LogRecord::Type::kGnss:
-      return AddGnss(r.gnss);
-    case LogRecord::Type::kGnssVelocity:
-      return AddGnssVelocity(r.gnss_velocity);
-  }
+  struct ToAdd {
+    EstimatorPipeline* pipeline;
+    void operator()(const ImuSample& m) const { pipeline->AddImu(m); }
+    void operator()(const WheelRecord& m) const { pipeline->AddWheel(m); }
+    void operator()(const GnssRecord& m) const { pipeline->AddGnss(m); }
+    void operator()(const GnssVelocityRecord& m) const { pipeline->AddGnssVelocity(m); }
+  };
+  std::visit(ToAdd{this}, r.data);
 }
 
 }  // namespace gins

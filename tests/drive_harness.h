@@ -62,8 +62,8 @@ inline DriveRun RunDriveThroughSession(const SimOptions& sim, const Options& opt
   while (simulator.Next(&rec)) {
     if (first) out.first_t = rec.t();
     first = false;
-    if (rec.type == SimRecord::Type::kImu) {
-      out.truth_t.push_back(rec.imu.t);
+    if (rec.is<ImuSample>()) {
+      out.truth_t.push_back(rec.get<ImuSample>().t);
       out.truth.push_back(rec.truth);
     }
     if (hook) {

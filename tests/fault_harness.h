@@ -30,7 +30,7 @@ class ReaderRules {
  public:
   bool Accept(const SimRecord& r) {
     const double t = r.t();
-    const size_t k = static_cast<size_t>(r.type);
+    const size_t k = r.type_index();
     if (t < newest_) {
       ++out_of_order;
       return false;
@@ -47,7 +47,11 @@ class ReaderRules {
 
  private:
   double newest_ = -std::numeric_limits<double>::infinity();
-  std::array<double, 4> last_{-1.0, -1.0, -1.0, -1.0};
+  std::array<double, kNumRecordTypes> last_ = [] {
+    std::array<double, kNumRecordTypes> none;
+    none.fill(-1.0);
+    return none;
+  }();
 };
 
 // The truth position at t, linear between the drive's IMU records (their truth is exact).

@@ -165,7 +165,12 @@ bool LogReader::Next(Record* record) {
 
 ReadCounts LogReader::counts() const {
   const ReadStats& s = impl_->reader->stats();
-  return {s.lines, s.imu, s.wheel, s.gnss, s.gnss_velocity, s.total_skipped()};
+  return {s.lines,
+          CountOf<ImuSample>(s.records),
+          CountOf<WheelRecord>(s.records),
+          CountOf<GnssRecord>(s.records),
+          CountOf<GnssVelocityRecord>(s.records),
+          s.total_skipped()};
 }
 
 bool LogReader::stopped() const { return impl_->reader->stopped(); }

@@ -1,5 +1,7 @@
 #include "apps/api/convert.h"
 
+#include <variant>
+
 namespace gins::api {
 namespace {
 
@@ -11,34 +13,45 @@ void Copy(const Vec3& v, double* out) {
   out[2] = v.z();
 }
 
+// The public record of each type: its type and member.
+void ToRecord(const ImuSample& m, Record* out) {
+  out->type = Record::Type::kImu;
+  out->imu.t = m.t;
+  Copy(m.gyro, out->imu.gyro);
+  Copy(m.acc, out->imu.acc);
+}
+
+void ToRecord(const WheelRecord& m, Record* out) {
+  out->type = Record::Type::kWheel;
+  out->wheel = {m.t, m.left_pulses, m.right_pulses};
+}
+
+void ToRecord(const GnssRecord& g, Record* out) {
+  out->type = Record::Type::kGnss;
+  out->gnss = {g.t, g.lat_deg, g.lon_deg, g.alt_m, g.heading_deg, g.heading_valid, g.has_sigma, {}};
+  Copy(g.sigma_enu, out->gnss.sigma_enu);
+}
+
+void ToRecord(const GnssVelocityRecord& g, Record* out) {
+  out->type = Record::Type::kGnssVelocity;
+  out->gnss_velocity.t = g.t;
+  Copy(g.v_enu, out->gnss_velocity.v_enu);
+  out->gnss_velocity.has_sigma = g.has_sigma;
+  Copy(g.sigma_enu, out->gnss_velocity.sigma_enu);
+}
+
 }  // namespace
 
-LogRecord ToLogRecord(const Imu& m) {
-  LogRecord r;
-  r.type = LogRecord::Type::kImu;
-  r.imu = {m.t, V(m.gyro), V(m.acc)};
-  return r;
-}
+LogRecord ToLogRecord(const Imu& m) { return {ImuSample{m.t, V(m.gyro), V(m.acc)}}; }
 
-LogRecord ToLogRecord(const Wheel& m) {
-  LogRecord r;
-  r.type = LogRecord::Type::kWheel;
-  r.wheel = {m.t, m.left_pulses, m.right_pulses};
-  return r;
-}
+LogRecord ToLogRecord(const Wheel& m) { return {WheelRecord{m.t, m.left_pulses, m.right_pulses}}; }
 
 LogRecord ToLogRecord(const Gnss& m) {
-  LogRecord r;
-  r.type = LogRecord::Type::kGnss;
-  r.gnss = {m.t, m.lat_deg, m.lon_deg, m.alt_m, m.heading_deg, m.heading_valid, m.has_sigma, V(m.sigma_enu)};
-  return r;
+  return {GnssRecord{m.t, m.lat_deg, m.lon_deg, m.alt_m, m.heading_deg, m.heading_valid, m.has_sigma, V(m.sigma_enu)}};
 }
 
 LogRecord ToLogRecord(const GnssVelocity& m) {
-  LogRecord r;
-  r.type = LogRecord::Type::kGnssVelocity;
-  r.gnss_velocity = {m.t, V(m.v_enu), m.has_sigma, V(m.sigma_enu)};
-  return r;
+  return {GnssVelocityRecord{m.t, V(m.v_enu), m.has_sigma, V(m.sigma_enu)}};
 }
 
 LogRecord ToLogRecord(const Record& r) {
@@ -64,32 +77,7 @@ LogRecord ToLogRecord(const Record& r) {
 Record ToRecord(const LogRecord& r) {
   Record out;
   out.line = r.line;
-  switch (r.type) {
-    case LogRecord::Type::kImu:
-      out.type = Record::Type::kImu;
-      out.imu.t = r.imu.t;
-      Copy(r.imu.gyro, out.imu.gyro);
-      Copy(r.imu.acc, out.imu.acc);
-      break;
-    case LogRecord::Type::kWheel:
-      out.type = Record::Type::kWheel;
-      out.wheel = {r.wheel.t, r.wheel.left_pulses, r.wheel.right_pulses};
-      break;
-    case LogRecord::Type::kGnss: {
-      const GnssRecord& g = r.gnss;
-      out.type = Record::Type::kGnss;
-      out.gnss = {g.t, g.lat_deg, g.lon_deg, g.alt_m, g.heading_deg, g.heading_valid, g.has_sigma, {}};
-      Copy(g.sigma_enu, out.gnss.sigma_enu);
-      break;
-    }
-    case LogRecord::Type::kGnssVelocity:
-      out.type = Record::Type::kGnssVelocity;
-      out.gnss_velocity.t = r.gnss_velocity.t;
-      Copy(r.gnss_velocity.v_enu, out.gnss_velocity.v_enu);
-      out.gnss_velocity.has_sigma = r.gnss_velocity.has_sigma;
-      Copy(r.gnss_velocity.sigma_enu, out.gnss_velocity.sigma_enu);
-      break;
-  }
+  std::visit([&out](const auto& m) { ToRecord(m, &out); }, r.data);
   return out;
 }
 
@@ -123,20 +111,6 @@ StateEstimate ToStateEstimate(const State& s) {
   e.sigma_att = V(s.sigma_att);
   e.odom_scale = s.odom_scale;
   return e;
-}
-
-const char* MeasurementName(LogRecord::Type type) {
-  switch (type) {
-    case LogRecord::Type::kImu:
-      return "imu";
-    case LogRecord::Type::kWheel:
-      return "wheel";
-    case LogRecord::Type::kGnss:
-      return "gnss";
-    case LogRecord::Type::kGnssVelocity:
-      return "gnss_velocity";
-  }
-  return "?";
 }
 
 }  // namespace gins::api

@@ -19,7 +19,4 @@ Record ToRecord(const LogRecord& r);
 void ToState(Stream stream, const StateEstimate& e, State* out);
 StateEstimate ToStateEstimate(const State& s);
 
-// "imu", "wheel", "gnss", "gnss_velocity": the names in Status::rejections.
-const char* MeasurementName(LogRecord::Type type);
-
 }  // namespace gins::api

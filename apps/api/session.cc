@@ -43,7 +43,7 @@ class Session::Impl {
  private:
   void Dispatch(const LogRecord& r);
   void Emit(Stream stream, const StateEstimate& e);
-  bool Reject(LogRecord::Type type, const std::string& reason);
+  bool Reject(const LogRecord& record, const std::string& reason);
   void RethrowCallbackError();
 
   const Options options_;
@@ -111,16 +111,16 @@ Session::Impl::Impl(const Options& options, const SessionOptions& session_option
 
 bool Session::Impl::Push(LogRecord record) {
   if (finished_) throw Error(Error::Kind::kUsage, "gins::api::Session: Push after Finish");
-  if (CheckLogRecord(&record, &issue_, imu_range_) == LineParse::kDamaged) return Reject(record.type, issue_.reason);
+  if (CheckLogRecord(&record, &issue_, imu_range_) == LineParse::kDamaged) return Reject(record, issue_.reason);
   // At the IMU time of their measurement (gnss.time_offset_s).
-  if (record.type == LogRecord::Type::kGnss) record.gnss.t -= options_.sensors.gnss.time_offset;
-  if (record.type == LogRecord::Type::kGnssVelocity) record.gnss_velocity.t -= options_.sensors.gnss.time_offset;
+  if (GnssRecord* fix = record.get_if<GnssRecord>()) fix->t -= options_.sensors.gnss.time_offset;
+  if (GnssVelocityRecord* velocity = record.get_if<GnssVelocityRecord>()) velocity->t -= options_.sensors.gnss.time_offset;
   if (options_.input.regularize_stamps) {
-    if (record.type == LogRecord::Type::kImu) record.imu.t = imu_clock_.Stamp(record.imu.t);
-    if (record.type == LogRecord::Type::kWheel) record.wheel.t = wheel_clock_.Stamp(record.wheel.t);
+    if (ImuSample* imu = record.get_if<ImuSample>()) imu->t = imu_clock_.Stamp(imu->t);
+    if (WheelRecord* wheel = record.get_if<WheelRecord>()) wheel->t = wheel_clock_.Stamp(wheel->t);
   }
   try {
-    if (!reorder_.Add(record, [this](const LogRecord& r) { Dispatch(r); })) return Reject(record.type, "late");
+    if (!reorder_.Add(record, [this](const LogRecord& r) { Dispatch(r); })) return Reject(record, "late");
   } catch (const RunError& e) {
     throw Error(Error::Kind::kInput, e.what());  // the data cannot be used as they are (core/imu_checks.h)
   } catch (const InputError& e) {
@@ -183,8 +183,8 @@ void Session::Impl::RethrowCallbackError() {
   if (callback_error_) std::rethrow_exception(std::exchange(callback_error_, nullptr));
 }
 
-bool Session::Impl::Reject(LogRecord::Type type, const std::string& reason) {
-  ++rejected_[{MeasurementName(type), reason}];
+bool Session::Impl::Reject(const LogRecord& record, const std::string& reason) {
+  ++rejected_[{record.info().name, reason}];
   ++rejected_total_;
   return false;
 }

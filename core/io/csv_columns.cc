@@ -217,14 +217,11 @@ const char* CsvReader::Convert(const TextLine& line, std::string* detail) {
   last_t_ = t;
   LogRecord r;
   if (map_.kind == CsvKind::kImu) {
-    r.type = LogRecord::Type::kImu;
-    r.imu = ImuSample{t, Vec3(v[1], v[2], v[3]), Vec3(v[4], v[5], v[6])};
+    r.data = ImuSample{t, Vec3(v[1], v[2], v[3]), Vec3(v[4], v[5], v[6])};
   } else if (map_.kind == CsvKind::kWheel) {
-    r.type = LogRecord::Type::kWheel;
-    r.wheel = WheelRecord{t, v[1], v[2]};
+    r.data = WheelRecord{t, v[1], v[2]};
   } else {
-    r.type = LogRecord::Type::kGnss;
-    GnssRecord& g = r.gnss;
+    GnssRecord& g = r.data.emplace<GnssRecord>();
     g.t = t;
     g.lat_deg = v[kLat];
     g.lon_deg = v[kLon];
@@ -237,12 +234,7 @@ const char* CsvReader::Convert(const TextLine& line, std::string* detail) {
   if (!Accept(&r, line.number, &lines_.issues(), "csv", 0)) return nullptr;
   pending_.push_back(r);
   if (map_.kind != CsvKind::kGnss || !Has(kVe)) return nullptr;
-  LogRecord vel;
-  vel.type = LogRecord::Type::kGnssVelocity;
-  vel.gnss_velocity.t = t;
-  vel.gnss_velocity.v_enu = Vec3(v[kVe], v[kVn], v[kVu]);
-  vel.gnss_velocity.has_sigma = Has(kSve);
-  vel.gnss_velocity.sigma_enu = Vec3(v[kSve], v[kSvn], v[kSvu]);
+  LogRecord vel{GnssVelocityRecord{t, Vec3(v[kVe], v[kVn], v[kVu]), Has(kSve), Vec3(v[kSve], v[kSvn], v[kSvu])}};
   if (Accept(&vel, line.number, &lines_.issues(), "csv", 0)) pending_.push_back(vel);
   return nullptr;
 }

@@ -18,15 +18,15 @@ class LogSource : public RecordSource {
   }
   bool Next(LogRecord* r) override {
     while (reader_.Next(r)) {
-      if (r->type == LogRecord::Type::kGnss || r->type == LogRecord::Type::kGnssVelocity) {
-        ++(r->type == LogRecord::Type::kGnss ? input_->dropped_gnss : input_->dropped_gvel);
+      if (r->is<GnssRecord>() || r->is<GnssVelocityRecord>()) {
+        ++(r->is<GnssRecord>() ? input_->dropped_gnss : input_->dropped_gvel);
         continue;
       }
       if (!file_.has_range) file_.t_first = r->t();
       file_.has_range = true;
       file_.t_last = r->t();
       ++file_.written;
-      ++stats_.records[static_cast<int>(r->type)];
+      ++stats_.records[r->type_index()];
       return true;
     }
     return false;
@@ -106,12 +106,7 @@ std::string Count(uint64_t n) { return std::to_string(n); }
 void AppendInput(const ConvertedInput& in, LogTimeScale scale, std::string* out) {
   const ConvertedFile& f = in.file;
   const GnssFileStats& s = in.stats;
-  std::string types;
-  for (int k = 0; k < LogRecord::kNumTypes; ++k) {
-    if (s.records[k] == 0) continue;
-    types +=
-        (types.empty() ? "" : ", ") + Count(s.records[k]) + " " + LogRecordTypeName(static_cast<LogRecord::Type>(k));
-  }
+  const std::string types = FormatRecordCounts(s.records, ZeroCounts::kHide);
   *out += FormatText("  %-5s ", in.role.c_str()) + in.kind + " " + f.path + ": " + Count(f.lines) + " lines, " +
           Count(f.written) + " records" + (types.empty() ? "" : " (" + types + ")");
   if (f.has_range) *out += FormatText(", t %.3f .. %.3f s", f.t_first, f.t_last);
@@ -169,7 +164,7 @@ GnssConversion ConvertGnss(const GnssConvertInputs& in, const InputOptions& opti
     out.Add(r);
     if (total++ == 0) c.t_first = r.t();
     c.t_last = std::max(c.t_last, r.t());
-    ++c.written[static_cast<int>(r.type)];
+    ++c.written[r.type_index()];
     live[next] = sources[next]->Next(&head[next]);
   }
   c.gnss.file = gnss->file();
@@ -180,13 +175,13 @@ GnssConversion ConvertGnss(const GnssConvertInputs& in, const InputOptions& opti
     c.wheel.file = wheel->file();
     c.wheel.stats = wheel->stats();
   }
-  if (c.written[static_cast<int>(LogRecord::Type::kGnss)] == 0) {
+  if (CountOf<GnssRecord>(c.written) == 0) {
     uint64_t dropped = 0;
     for (const auto& [what, n] : c.gnss.stats.dropped) dropped += n;
     throw InputError(in.gnss_path + ": no usable fixes in " + Count(c.gnss.file.lines) + " lines (" +
                      Count(c.gnss.file.total_skipped()) + " damaged, " + Count(dropped) + " dropped by quality)");
   }
-  if (c.written[static_cast<int>(LogRecord::Type::kImu)] == 0) {
+  if (CountOf<ImuSample>(c.written) == 0) {
     throw InputError(in.imu_path + ": no IMU records in " + Count(c.imu.file.lines) + " lines");
   }
   CheckTimeBases(c.imu, c.gnss);
@@ -195,11 +190,8 @@ GnssConversion ConvertGnss(const GnssConvertInputs& in, const InputOptions& opti
 }
 
 std::string FormatGnssConversionSummary(const GnssConversion& c) {
-  std::string types;
-  for (int k = 0; k < LogRecord::kNumTypes; ++k) {
-    types += (k > 0 ? ", " : "") + Count(c.written[k]) + " " + LogRecordTypeName(static_cast<LogRecord::Type>(k));
-  }
-  std::string out = "gins convert: " + c.gnss.kind + " -> " + c.out_path + " (" + types + " records; t " +
+  std::string out = "gins convert: " + c.gnss.kind + " -> " + c.out_path + " (" +
+                    FormatRecordCounts(c.written, ZeroCounts::kShow) + " records; t " +
                     FormatText("%.3f .. %.3f s", c.t_first, c.t_last) + ")\n";
   AppendInput(c.gnss, c.time_scale, &out);
   AppendInput(c.imu, c.time_scale, &out);

@@ -43,7 +43,7 @@ struct GnssConversion {
   ConvertedInput gnss, imu, wheel;
   bool has_wheel = false;
   LogTimeScale time_scale = LogTimeScale::kGps;  // the log's clock
-  uint64_t written[LogRecord::kNumTypes] = {};   // by LogRecord::Type
+  RecordCounts written{};
   double t_first = 0.0, t_last = 0.0;            // the log's time span
 };
 

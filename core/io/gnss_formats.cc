@@ -23,7 +23,7 @@ bool RecordSource::Accept(LogRecord* record, uint64_t line, FileIssues* issues, 
   InputIssue issue;
   if (CheckLogRecord(record, &issue) == LineParse::kDamaged) {
     issues->Damage(line, issue.reason.c_str(),
-                   std::string("as a ") + LogRecordTypeName(record->type) + " record: " + issue.detail);
+                   std::string("as a ") + record->info().token + " record: " + issue.detail);
     return false;
   }
   record->line = line;
@@ -33,8 +33,8 @@ bool RecordSource::Accept(LogRecord* record, uint64_t line, FileIssues* issues, 
   file_.t_last = t;
   ++file_.written;
   ++stats_.leap_seconds[leap_seconds];
-  ++stats_.records[static_cast<int>(record->type)];
-  if (record->type == LogRecord::Type::kGnss) ++stats_.qualities[quality];
+  ++stats_.records[record->type_index()];
+  if (record->is<GnssRecord>()) ++stats_.qualities[quality];
   return true;
 }
 

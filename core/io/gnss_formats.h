@@ -61,7 +61,7 @@ struct GnssFormatOptions {
 
 // What became of a GNSS file beyond ConvertedFile's lines, records and damage.
 struct GnssFileStats {
-  uint64_t records[LogRecord::kNumTypes] = {};  // records given, by LogRecord::Type
+  RecordCounts records{};                       // records given
   std::map<std::string, uint64_t> dropped;      // "quality single (below --min-quality float)" -> count
   std::map<int, uint64_t> leap_seconds;         // GPS − UTC applied (s) -> records
   std::map<std::string, uint64_t> qualities;    // quality class name -> GNSS records given

@@ -369,11 +369,11 @@ I2navConversion ConvertI2nav(const I2navInputs& inputs, const InputOptions& opti
   out.Comment(c.header);
   while (have_imu || have_gnss) {
     if (have_imu && (!have_gnss || s.t <= g.t)) {  // ties: IMU first
-      out.Imu(s);
+      out.Add({s});
       ++c.imu.written;
       have_imu = imu.Next(&s);
     } else {
-      out.Gnss(g);
+      out.Add({g});
       ++c.gnss.written;
       have_gnss = gnss.Next(&g);
     }

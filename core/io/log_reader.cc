@@ -66,8 +66,8 @@ class LogReader::Impl {
   // Time order: the newest accepted time, and the last accepted time per record type.
   bool have_newest_ = false;
   double newest_t_ = 0.0;
-  std::array<bool, LogRecord::kNumTypes> have_last_{};
-  std::array<double, LogRecord::kNumTypes> last_t_{};
+  std::array<bool, kNumRecordTypes> have_last_{};
+  std::array<double, kNumRecordTypes> last_t_{};
   // Consecutive time_jump records that agree with each other (a real jump of the log's clock).
   int jump_run_ = 0;
   double jump_last_t_ = 0.0;
@@ -119,7 +119,7 @@ bool LogReader::Impl::DamagedByReading(const TextLine& line) {
 }
 
 void LogReader::Impl::CheckTime(const LogRecord& record, const char** reason, std::string* detail) {
-  const size_t k = static_cast<size_t>(record.type);
+  const size_t k = record.type_index();
   const double t = record.t();
   const double max_jump = options_.max_time_jump;
   if (have_newest_ && t < newest_t_ - options_.reorder_window) {
@@ -144,12 +144,12 @@ void LogReader::Impl::CheckTime(const LogRecord& record, const char** reason, st
     }
   } else if (have_last_[k] && t == last_t_[k]) {
     *reason = kDuplicate;
-    *detail = std::string("a second ") + LogRecordTypeName(record.type) + " record at t = " + Time(t);
+    *detail = std::string("a second ") + record.info().token + " record at t = " + Time(t);
   }
 }
 
 void LogReader::Impl::Accept(LogRecord* record, uint64_t line) {
-  const size_t k = static_cast<size_t>(record->type);
+  const size_t k = record->type_index();
   jump_run_ = 0;  // a record in time order ends any run of jumped ones
   // Within the reorder window a record may be older than the newest one.
   newest_t_ = have_newest_ ? std::max(newest_t_, record->t()) : record->t();
@@ -158,20 +158,7 @@ void LogReader::Impl::Accept(LogRecord* record, uint64_t line) {
   last_t_[k] = record->t();
   have_last_[k] = true;
   record->line = line;
-  switch (record->type) {
-    case LogRecord::Type::kImu:
-      ++stats_->imu;
-      break;
-    case LogRecord::Type::kWheel:
-      ++stats_->wheel;
-      break;
-    case LogRecord::Type::kGnss:
-      ++stats_->gnss;
-      break;
-    case LogRecord::Type::kGnssVelocity:
-      ++stats_->gnss_velocity;
-      break;
-  }
+  ++stats_->records[k];
 }
 
 bool LogReader::Impl::Next(LogRecord* record) {
@@ -230,6 +217,17 @@ LogReader::~LogReader() = default;
 bool LogReader::stopped() const { return impl_->stopped(); }
 
 bool LogReader::Next(LogRecord* record) { return impl_->Next(record); }
+
+std::string FormatRecordCounts(const RecordCounts& counts, ZeroCounts zeros) {
+  std::string out;
+  for (size_t k = 0; k < kNumRecordTypes; ++k) {
+    const bool hidden =
+        zeros == ZeroCounts::kHide || (zeros == ZeroCounts::kHideQuiet && kRecordTypes[k].quiet_when_none);
+    if (counts[k] == 0 && hidden) continue;
+    out += (out.empty() ? "" : ", ") + std::to_string(counts[k]) + " " + kRecordTypes[k].token;
+  }
+  return out;
+}
 
 std::string FormatIssueCounts(const char* kind, const std::map<std::string, uint64_t>& counts,
                               const std::vector<InputIssue>& issues) {

@@ -19,6 +19,7 @@
 // text_input.cc.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -88,9 +89,14 @@ struct InputIssue {
 std::string FormatIssueCounts(const char* kind, const std::map<std::string, uint64_t>& counts,
                               const std::vector<InputIssue>& issues);
 
+// "12 IMU, 3 ODOM, 2 GNSS, 0 GVEL" in the types' order; which zero counts it leaves out: none, all, or those
+// of the types a log may well lack (RecordTypeInfo::quiet_when_none).
+enum class ZeroCounts { kShow, kHide, kHideQuiet };
+std::string FormatRecordCounts(const RecordCounts& counts, ZeroCounts zeros);
+
 struct ReadStats {
   uint64_t lines = 0;
-  uint64_t imu = 0, wheel = 0, gnss = 0, gnss_velocity = 0;  // records accepted
+  RecordCounts records{};  // records accepted (CountOf<ImuSample>(records): the IMU's)
   std::map<std::string, uint64_t> skipped;  // reason -> count
   std::vector<InputIssue> examples;        // up to kMaxExamplesPerReason per reason
   // Every damaged line's number, by reason (at most input.max_errors + 1 in all: then the read stops).

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cstdio>
 #include <stdexcept>
+#include <variant>
 #include <vector>
 
 namespace gins {
@@ -24,6 +25,35 @@ void AppendNumber(std::string* out, double v) {
   buf[0] = ' ';
   const std::to_chars_result r = std::to_chars(buf + 1, buf + sizeof(buf), v);
   out->append(buf, r.ptr);
+}
+
+// A record's fields after its time stamp.
+void AppendFields(std::string* out, const ImuSample& s) {
+  for (int i = 0; i < 3; ++i) AppendNumber(out, s.gyro[i]);
+  for (int i = 0; i < 3; ++i) AppendNumber(out, s.acc[i]);
+}
+
+void AppendFields(std::string* out, const WheelRecord& o) {
+  AppendNumber(out, o.left_pulses);
+  AppendNumber(out, o.right_pulses);
+}
+
+void AppendFields(std::string* out, const GnssRecord& g) {
+  AppendNumber(out, g.lat_deg);
+  AppendNumber(out, g.lon_deg);
+  AppendNumber(out, g.alt_m);
+  AppendNumber(out, g.heading_valid ? g.heading_deg : 0.0);
+  *out += g.heading_valid ? " 1" : " 0";
+  if (g.has_sigma) {
+    for (int i = 0; i < 3; ++i) AppendNumber(out, g.sigma_enu[i]);
+  }
+}
+
+void AppendFields(std::string* out, const GnssVelocityRecord& v) {
+  for (int i = 0; i < 3; ++i) AppendNumber(out, v.v_enu[i]);
+  if (v.has_sigma) {
+    for (int i = 0; i < 3; ++i) AppendNumber(out, v.sigma_enu[i]);
+  }
 }
 
 }  // namespace
@@ -89,61 +119,17 @@ void LogWriter::Comment(std::string_view text) {
   Put(line);
 }
 
-void LogWriter::Imu(const ImuSample& s) {
-  buf_ += "IMU";
-  AppendNumber(&buf_, s.t);
-  for (int i = 0; i < 3; ++i) AppendNumber(&buf_, s.gyro[i]);
-  for (int i = 0; i < 3; ++i) AppendNumber(&buf_, s.acc[i]);
-  Put("\n");
-  ++records_;
-}
-
-void LogWriter::Gnss(const GnssRecord& g) {
-  buf_ += "GNSS";
-  AppendNumber(&buf_, g.t);
-  AppendNumber(&buf_, g.lat_deg);
-  AppendNumber(&buf_, g.lon_deg);
-  AppendNumber(&buf_, g.alt_m);
-  AppendNumber(&buf_, g.heading_valid ? g.heading_deg : 0.0);
-  buf_ += g.heading_valid ? " 1" : " 0";
-  if (g.has_sigma) {
-    for (int i = 0; i < 3; ++i) AppendNumber(&buf_, g.sigma_enu[i]);
-  }
-  Put("\n");
-  ++records_;
-}
-
-void LogWriter::Odom(const WheelRecord& o) {
-  buf_ += "ODOM";
-  AppendNumber(&buf_, o.t);
-  AppendNumber(&buf_, o.left_pulses);
-  AppendNumber(&buf_, o.right_pulses);
-  Put("\n");
-  ++records_;
-}
-
-void LogWriter::Gvel(const GnssVelocityRecord& v) {
-  buf_ += "GVEL";
-  AppendNumber(&buf_, v.t);
-  for (int i = 0; i < 3; ++i) AppendNumber(&buf_, v.v_enu[i]);
-  if (v.has_sigma) {
-    for (int i = 0; i < 3; ++i) AppendNumber(&buf_, v.sigma_enu[i]);
-  }
+template <typename R>
+void LogWriter::Write(const R& m) {
+  buf_ += RecordTraits<R>::kInfo.token;
+  AppendNumber(&buf_, m.t);
+  AppendFields(&buf_, m);
   Put("\n");
   ++records_;
 }
 
 void LogWriter::Add(const LogRecord& r) {
-  switch (r.type) {
-    case LogRecord::Type::kImu:
-      return Imu(r.imu);
-    case LogRecord::Type::kWheel:
-      return Odom(r.wheel);
-    case LogRecord::Type::kGnss:
-      return Gnss(r.gnss);
-    case LogRecord::Type::kGnssVelocity:
-      return Gvel(r.gnss_velocity);
-  }
+  std::visit([this](const auto& m) { Write(m); }, r.data);
 }
 
 void LogWriter::Commit() {

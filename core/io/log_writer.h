@@ -24,11 +24,9 @@ class LogWriter {
 
   // "# <text>" (one line: newlines in text become spaces).
   void Comment(std::string_view text);
-  void Imu(const ImuSample& s);     // IMU t gx gy gz ax ay az
-  void Gnss(const GnssRecord& g);   // GNSS t lat lon alt heading valid [σe σn σu]
-  void Odom(const WheelRecord& o);   // ODOM t left_pulses right_pulses
-  void Gvel(const GnssVelocityRecord& v);   // GVEL t ve vn vu [σe σn σu]
-  void Add(const LogRecord& r);     // the one of the four its type names
+  // "<token> t <fields>": IMU t gx gy gz ax ay az, ODOM t left_pulses right_pulses, GNSS t lat lon alt
+  // heading valid [σe σn σu] (the heading 0 when not valid), GVEL t ve vn vu [σe σn σu].
+  void Add(const LogRecord& r);
   // Finishes the file and renames it into place; throws std::runtime_error on any I/O error. Without
   // Commit() the file never appears.
   void Commit();
@@ -38,6 +36,8 @@ class LogWriter {
 
  private:
   class Gzip;
+  template <typename R>
+  void Write(const R& m);
   void Put(std::string_view text);
   void Flush();
 

@@ -206,8 +206,7 @@ void NmeaReader::Emit(const Epoch& e, double t, int leap) {
                      FixQualityName(format_.min_quality) + ")"];
   } else if (e.has_gga) {
     LogRecord r;
-    r.type = LogRecord::Type::kGnss;
-    GnssRecord& g = r.gnss;
+    GnssRecord& g = r.data.emplace<GnssRecord>();
     g.t = t;
     g.lat_deg = e.gga.lat;
     g.lon_deg = e.gga.lon;
@@ -227,13 +226,13 @@ void NmeaReader::Emit(const Epoch& e, double t, int leap) {
   }
   if (!e.has_velocity) return;
   LogRecord r;
-  r.type = LogRecord::Type::kGnssVelocity;
-  r.gnss_velocity.t = t;
-  r.gnss_velocity.v_enu = e.v_enu;
-  r.gnss_velocity.has_sigma = true;
+  GnssVelocityRecord& velocity = r.data.emplace<GnssVelocityRecord>();
+  velocity.t = t;
+  velocity.v_enu = e.v_enu;
+  velocity.has_sigma = true;
   // NMEA has no vertical speed: vu = 0 with a σ that allows a grade of vertical_sigma_per_speed.
   const double h = format_.velocity_sigma_m_s;
-  r.gnss_velocity.sigma_enu =
+  velocity.sigma_enu =
       Vec3(h, h, std::max(format_.vertical_velocity_sigma_m_s, format_.vertical_sigma_per_speed * e.speed));
   if (Accept(&r, e.first_line, &lines_.issues(), "", leap)) pending_.push_back(r);
 }

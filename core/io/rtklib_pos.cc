@@ -283,8 +283,7 @@ const char* RtklibPosReader::Convert(const TextLine& line, std::string* detail) 
     return kUnknownQuality;
   }
   LogRecord fix;
-  fix.type = LogRecord::Type::kGnss;
-  GnssRecord& g = fix.gnss;
+  GnssRecord& g = fix.data.emplace<GnssRecord>();
   Mat3 R_ecef_enu = Mat3::Identity();
   if (const char* reason = ReadPosition(&g.lat_deg, &g.lon_deg, &g.alt_m, &R_ecef_enu, detail)) return reason;
   double sd[6], sdv[6];
@@ -293,14 +292,14 @@ const char* RtklibPosReader::Convert(const TextLine& line, std::string* detail) 
     if (const char* reason = ReadSigma(layout_.sd, sd, detail)) return reason;
   }
   LogRecord vel;
-  vel.type = LogRecord::Type::kGnssVelocity;
+  GnssVelocityRecord& velocity = vel.data.emplace<GnssVelocityRecord>();
   const bool has_vel = layout_.vel[0] >= 0 && layout_.vel[1] >= 0 && layout_.vel[2] >= 0;
   Vec3 v;
   for (int i = 0; i < 3 && has_vel; ++i) {
     if (const char* reason = Number(layout_.vel[i], "velocity", &v[i], detail)) return reason;
   }
-  vel.gnss_velocity.has_sigma = has_vel && layout_.sdv[0] >= 0 && layout_.sdv[1] >= 0 && layout_.sdv[2] >= 0;
-  if (vel.gnss_velocity.has_sigma) {
+  velocity.has_sigma = has_vel && layout_.sdv[0] >= 0 && layout_.sdv[1] >= 0 && layout_.sdv[2] >= 0;
+  if (velocity.has_sigma) {
     if (const char* reason = ReadSigma(layout_.sdv, sdv, detail)) return reason;
   }
   // Everything parsed: now the order, then what is kept.
@@ -330,10 +329,10 @@ const char* RtklibPosReader::Convert(const TextLine& line, std::string* detail) 
   if (!Accept(&fix, line.number, &lines_.issues(), FixQualityName(quality), leap)) return nullptr;
   pending_.push_back(fix);
   if (!has_vel) return nullptr;
-  vel.gnss_velocity.t = t;
-  vel.gnss_velocity.v_enu = ecef ? Vec3(R_ecef_enu.transpose() * v) : v;
-  if (vel.gnss_velocity.has_sigma) {
-    vel.gnss_velocity.sigma_enu =
+  velocity.t = t;
+  velocity.v_enu = ecef ? Vec3(R_ecef_enu.transpose() * v) : v;
+  if (velocity.has_sigma) {
+    velocity.sigma_enu =
         ecef ? SigmaOf(R_ecef_enu.transpose() * Covariance(sdv) * R_ecef_enu) : Floored(sdv[0], sdv[1], sdv[2]);
   }
   if (Accept(&vel, line.number, &lines_.issues(), FixQualityName(quality), leap)) pending_.push_back(vel);

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
+#include <variant>
 
 #include <GeographicLib/Geocentric.hpp>
 
@@ -56,7 +57,19 @@ void WriteTruthRow(const Simulator& simulator, const NavState& x, AtomicFile* tr
                                     v.z()));
 }
 
-void WriteGnss(const GnssRecord& g, AtomicFile* log) {
+// A record's log line, at the simulator's own precision.
+void WriteLine(const ImuSample& m, AtomicFile* log) {
+  CheckedPrintf(log, std::fprintf(log->stream(), "IMU %.6f %.9e %.9e %.9e %.9e %.9e %.9e\n", m.t, m.gyro.x(),
+                                  m.gyro.y(), m.gyro.z(), m.acc.x(), m.acc.y(), m.acc.z()));
+}
+
+void WriteLine(const WheelRecord& w, AtomicFile* log) {
+  // Whole pulses, printed as integers (a rounded −0.4 would print as "-0" with %.0f).
+  CheckedPrintf(log, std::fprintf(log->stream(), "ODOM %.6f %lld %lld\n", w.t, std::llround(w.left_pulses),
+                                  std::llround(w.right_pulses)));
+}
+
+void WriteLine(const GnssRecord& g, AtomicFile* log) {
   CheckedPrintf(log, std::fprintf(log->stream(), "GNSS %.6f %.10f %.10f %.4f %.5f %d", g.t, g.lat_deg, g.lon_deg,
                                   g.alt_m, g.heading_deg, g.heading_valid ? 1 : 0));
   if (g.has_sigma) {
@@ -66,35 +79,16 @@ void WriteGnss(const GnssRecord& g, AtomicFile* log) {
   CheckedPrintf(log, std::fputs("\n", log->stream()));
 }
 
+void WriteLine(const GnssVelocityRecord& g, AtomicFile* log) {
+  CheckedPrintf(log, std::fprintf(log->stream(), "GVEL %.6f %.4f %.4f %.4f %.4f %.4f %.4f\n", g.t, g.v_enu.x(),
+                                  g.v_enu.y(), g.v_enu.z(), g.sigma_enu.x(), g.sigma_enu.y(), g.sigma_enu.z()));
+}
+
 void WriteRecord(const Simulator& simulator, const SimRecord& r, AtomicFile* log, AtomicFile* truth,
                  SimulationResult* result) {
-  switch (r.type) {
-    case SimRecord::Type::kImu: {
-      const ImuSample& m = r.imu;
-      CheckedPrintf(log, std::fprintf(log->stream(), "IMU %.6f %.9e %.9e %.9e %.9e %.9e %.9e\n", m.t, m.gyro.x(),
-                                      m.gyro.y(), m.gyro.z(), m.acc.x(), m.acc.y(), m.acc.z()));
-      WriteTruthRow(simulator, r.truth, truth);
-      ++result->imu;
-      break;
-    }
-    case SimRecord::Type::kWheel:
-      // Whole pulses, printed as integers (a rounded −0.4 would print as "-0" with %.0f).
-      CheckedPrintf(log, std::fprintf(log->stream(), "ODOM %.6f %lld %lld\n", r.wheel.t,
-                                      std::llround(r.wheel.left_pulses), std::llround(r.wheel.right_pulses)));
-      ++result->wheel;
-      break;
-    case SimRecord::Type::kGnss:
-      WriteGnss(r.gnss, log);
-      ++result->gnss;
-      break;
-    case SimRecord::Type::kGnssVelocity: {
-      const GnssVelocityRecord& g = r.gnss_velocity;
-      CheckedPrintf(log, std::fprintf(log->stream(), "GVEL %.6f %.4f %.4f %.4f %.4f %.4f %.4f\n", g.t, g.v_enu.x(),
-                                      g.v_enu.y(), g.v_enu.z(), g.sigma_enu.x(), g.sigma_enu.y(), g.sigma_enu.z()));
-      ++result->gnss_velocity;
-      break;
-    }
-  }
+  std::visit([log](const auto& m) { WriteLine(m, log); }, r.data);
+  if (r.is<ImuSample>()) WriteTruthRow(simulator, r.truth, truth);
+  ++result->records[r.type_index()];
 }
 
 // obs.rnx: the raw observations of the antenna over the logged span (core/sim/raw_gnss.h). w is the local ENU

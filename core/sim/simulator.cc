@@ -133,17 +133,17 @@ void Simulator::MakeImu(SimRecord* r) {
   const TruthState x = truth_.AtElapsed(std::min(s, truth_.duration()));
   const Vec3 noise_g = sim_.gyro_noise_density * std::sqrt(rate) * rng_imu_noise_.Normal3();
   const Vec3 noise_a = sim_.acc_noise_density * std::sqrt(rate) * rng_imu_noise_.Normal3();
-  r->type = SimRecord::Type::kImu;
-  r->imu.t = sim_.start_time + s;
+  ImuSample& imu = r->data.emplace<ImuSample>();
+  imu.t = sim_.start_time + s;
   if (sim_.earth_rotation) {
     // The gyro measures the rotation against inertial space; the accelerometer, the specific force in the
     // inertial frame: a_w plus Coriolis, minus the gravity (with its centrifugal part) at the vehicle.
     const Quat q_bw = x.q_wb.conjugate();
-    r->imu.gyro = x.omega_b + q_bw * earth_rate_w_ + bg_ + noise_g;
-    r->imu.acc = q_bw * (x.a_w + 2.0 * earth_rate_w_.cross(x.v_w) - GravityAt(x.p_wb)) + ba_ + noise_a;
+    imu.gyro = x.omega_b + q_bw * earth_rate_w_ + bg_ + noise_g;
+    imu.acc = q_bw * (x.a_w + 2.0 * earth_rate_w_.cross(x.v_w) - GravityAt(x.p_wb)) + ba_ + noise_a;
   } else {
-    r->imu.gyro = x.omega_b + bg_ + noise_g;
-    r->imu.acc = x.q_wb.conjugate() * (x.a_w - truth_.gravity_w()) + ba_ + noise_a;
+    imu.gyro = x.omega_b + bg_ + noise_g;
+    imu.acc = x.q_wb.conjugate() * (x.a_w - truth_.gravity_w()) + ba_ + noise_a;
   }
   r->truth = x.ToNavState();
   r->truth.bg = bg_;
@@ -165,10 +165,10 @@ void Simulator::MakeWheel(SimRecord* r) {
   const Vec2 counts = distance * sim_.pulses_per_rev / (2.0 * kPi * sim_.wheel_radius) + pulse_carry_;
   const Vec2 pulses(std::round(counts.x()), std::round(counts.y()));
   pulse_carry_ = counts - pulses;
-  r->type = SimRecord::Type::kWheel;
-  r->wheel.t = sim_.start_time + static_cast<double>(i_wheel_) / sim_.wheel_rate;
-  r->wheel.left_pulses = pulses.x();
-  r->wheel.right_pulses = pulses.y();
+  WheelRecord& wheel = r->data.emplace<WheelRecord>();
+  wheel.t = sim_.start_time + static_cast<double>(i_wheel_) / sim_.wheel_rate;
+  wheel.left_pulses = pulses.x();
+  wheel.right_pulses = pulses.y();
   FillTruth(s1, r);
   ++i_wheel_;
 }
@@ -203,15 +203,15 @@ bool Simulator::MakeGnss(SimRecord* r) {
     yaw_G = std::atan2(x_G_w.y(), x_G_w.x()) + sim_.heading_sigma * heading_noise;
   }
 
-  r->type = SimRecord::Type::kGnss;
-  r->gnss.t = sim_.start_time + s;
-  r->gnss.lat_deg = geo.lat_deg;
-  r->gnss.lon_deg = geo.lon_deg;
-  r->gnss.alt_m = geo.alt_m;
-  r->gnss.heading_valid = heading_valid;
-  r->gnss.heading_deg = heading_valid ? EnuYawToCompassDeg(yaw_G) : 0.0;
-  r->gnss.has_sigma = sim_.write_gnss_sigma;
-  if (sim_.write_gnss_sigma) r->gnss.sigma_enu = sim_.gnss_sigma_enu;
+  GnssRecord& fix = r->data.emplace<GnssRecord>();
+  fix.t = sim_.start_time + s;
+  fix.lat_deg = geo.lat_deg;
+  fix.lon_deg = geo.lon_deg;
+  fix.alt_m = geo.alt_m;
+  fix.heading_valid = heading_valid;
+  fix.heading_deg = heading_valid ? EnuYawToCompassDeg(yaw_G) : 0.0;
+  fix.has_sigma = sim_.write_gnss_sigma;
+  if (sim_.write_gnss_sigma) fix.sigma_enu = sim_.gnss_sigma_enu;
   r->gnss_outlier = outlier;
   FillTruth(s, r);
   if ((sim_.gnss_velocity_sigma.array() > 0.0).any()) {
@@ -239,11 +239,11 @@ void Simulator::MakeGnssVelocity(double s, const TruthState& x, const Vec3& p_an
   // Doppler measures the antenna's velocity against the Earth, given in the local ENU frame at the antenna.
   const Vec3 v_ant_w = x.v_w + x.q_wb * x.omega_b.cross(sim_.lever_b);
   pending_ = SimRecord();
-  pending_.type = SimRecord::Type::kGnssVelocity;
-  pending_.gnss_velocity.t = sim_.start_time + s;
-  pending_.gnss_velocity.v_enu = LocalToWorld(p_ant_w).transpose() * v_ant_w + sim_.gnss_velocity_sigma.cwiseProduct(normals);
-  pending_.gnss_velocity.has_sigma = true;
-  pending_.gnss_velocity.sigma_enu = sim_.gnss_velocity_sigma;
+  GnssVelocityRecord& velocity = pending_.data.emplace<GnssVelocityRecord>();
+  velocity.t = sim_.start_time + s;
+  velocity.v_enu = LocalToWorld(p_ant_w).transpose() * v_ant_w + sim_.gnss_velocity_sigma.cwiseProduct(normals);
+  velocity.has_sigma = true;
+  velocity.sigma_enu = sim_.gnss_velocity_sigma;
   pending_from_ = s;
   gnss_velocity_pending_ = true;
 }

@@ -269,7 +269,7 @@ class Simulator {
 };
 
 struct SimulationResult {
-  uint64_t imu = 0, gnss = 0, wheel = 0, gnss_velocity = 0;
+  RecordCounts records{};        // of log.txt
   uint64_t raw_gnss_epochs = 0;  // of obs.rnx, when simulate.raw_gnss_enabled
   double duration = 0.0;  // s, of the whole drive (from start_time, whatever log_start)
 };

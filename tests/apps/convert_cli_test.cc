@@ -111,13 +111,13 @@ void WriteI2nav(const std::string& log, const std::string& imu_path, const std::
   ImuSample prev;
   *n_imu = 0;
   while (reader.Next(&r)) {
-    if (r.type == LogRecord::Type::kGnss) {
-      const GnssRecord& g = r.gnss;
+    if (r.is<GnssRecord>()) {
+      const GnssRecord& g = r.get<GnssRecord>();
       gnss += Fixed(g.t, 3) + " " + Fixed(g.lat_deg, 11) + " " + Fixed(g.lon_deg, 11) + " " + Fixed(g.alt_m, 4) + " " +
               Sci(g.sigma_enu.y()) + " " + Sci(g.sigma_enu.x()) + " " + Sci(g.sigma_enu.z()) + "\n";
     }
-    if (r.type != LogRecord::Type::kImu) continue;
-    const ImuSample& s = r.imu;
+    if (!r.is<ImuSample>()) continue;
+    const ImuSample& s = r.get<ImuSample>();
     const double dt = have_prev ? s.t - prev.t : 0.005;
     const Vec3 w = have_prev ? 0.5 * (prev.gyro + s.gyro) : s.gyro;
     const Vec3 f = have_prev ? 0.5 * (prev.acc + s.acc) : s.acc;
@@ -210,7 +210,7 @@ TEST(ConvertCli, SimulatedI2navDriveConvertsAndRunsInEskf) {
   LogReader reader(log, stop);
   for (LogRecord r; reader.Next(&r);) {
   }
-  EXPECT_EQ(reader.stats().imu, n_imu);
+  EXPECT_EQ(CountOf<ImuSample>(reader.stats().records), n_imu);
 
   const std::string log_with_wheels = dir + "/converted_with_wheels.txt", out = dir + "/out";
   test::WriteFile(log_with_wheels, WithWheels(log, sim + "/log.txt"));
@@ -251,7 +251,7 @@ std::vector<GnssRecord> Fixes(const std::string& log) {
   LogReader reader(log, InputOptions{});
   std::vector<GnssRecord> fixes;
   for (LogRecord r; reader.Next(&r);) {
-    if (r.type == LogRecord::Type::kGnss) fixes.push_back(r.gnss);
+    if (r.is<GnssRecord>()) fixes.push_back(r.get<GnssRecord>());
   }
   return fixes;
 }

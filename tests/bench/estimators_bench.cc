@@ -42,8 +42,8 @@ void RunDrive(benchmark::State& state, MakeEstimator make) {
     session.AddEstimator(make(options));
     for (const auto& r : records) {
       test::FeedSession(&session, r);
-      imu += r.type == SimRecord::Type::kImu;
-      gnss += r.type == SimRecord::Type::kGnss;
+      imu += r.is<ImuSample>();
+      gnss += r.is<GnssRecord>();
     }
     session.Finish();
   }
@@ -73,7 +73,7 @@ class EskfFixture {
     session_->AddEstimator(std::move(eskf));
     for (const auto& r : DriveRecords()) {
       test::FeedSession(session_.get(), r);
-      if (session_->initialized() && r.type == SimRecord::Type::kGnss) break;
+      if (session_->initialized() && r.is<GnssRecord>()) break;
     }
   }
   Eskf* eskf() { return eskf_; }

@@ -283,17 +283,17 @@ TEST(DocsReferences, FormatsExampleLogReadsWithoutDamage) {
   std::vector<LogRecord> records;
   while (reader.Next(&r)) records.push_back(r);
   EXPECT_EQ(reader.stats().total_skipped(), 0u);
-  EXPECT_EQ(reader.stats().imu, 5u);
-  EXPECT_EQ(reader.stats().wheel, 2u);
-  EXPECT_EQ(reader.stats().gnss, 2u);
-  EXPECT_EQ(reader.stats().gnss_velocity, 1u);
+  EXPECT_EQ(CountOf<ImuSample>(reader.stats().records), 5u);
+  EXPECT_EQ(CountOf<WheelRecord>(reader.stats().records), 2u);
+  EXPECT_EQ(CountOf<GnssRecord>(reader.stats().records), 2u);
+  EXPECT_EQ(CountOf<GnssVelocityRecord>(reader.stats().records), 1u);
   // §3.8: the first fix's heading with gnss.mount_yaw_deg 12.06 is a vehicle facing north-east (§2.4).
   const auto first_fix = std::find_if(records.begin(), records.end(),
-                                      [](const LogRecord& x) { return x.type == LogRecord::Type::kGnss; });
+                                      [](const LogRecord& x) { return x.is<GnssRecord>(); });
   ASSERT_NE(first_fix, records.end());
-  ASSERT_TRUE(first_fix->gnss.heading_valid);
-  EXPECT_NEAR(CompassDegToEnuYaw(first_fix->gnss.heading_deg + 12.06), 45.0 * kDegToRad, 1e-9);
-  EXPECT_TRUE(first_fix->gnss.has_sigma);
+  ASSERT_TRUE(first_fix->get<GnssRecord>().heading_valid);
+  EXPECT_NEAR(CompassDegToEnuYaw(first_fix->get<GnssRecord>().heading_deg + 12.06), 45.0 * kDegToRad, 1e-9);
+  EXPECT_TRUE(first_fix->get<GnssRecord>().has_sigma);
 }
 
 TEST(DocsReferences, FormatsExampleTruthReadsAsDescribed) {

@@ -42,49 +42,40 @@ InitRun Feed(const SimOptions& sim, const Options& options) {
   InitRun run;
   SimRecord rec;
   while (simulator.Next(&rec)) {
-    switch (rec.type) {
-      case SimRecord::Type::kImu:
-        init.AddImu(rec.imu);
-        break;
-      case SimRecord::Type::kWheel: {
-        const WheelOptions& wo = options.sensors.wheel;
-        WheelMeasurement w;
-        w.t = rec.wheel.t;
-        w.speed = 0.5 * (WheelSpeedFromPulses(rec.wheel.left_pulses, wo.radius, wo.pulses_per_rev, wo.interval) +
-                         WheelSpeedFromPulses(rec.wheel.right_pulses, wo.radius, wo.pulses_per_rev, wo.interval));
-        w.sigma = wo.speed_sigma;
-        w.interval = wo.interval;
-        w.standstill = rec.wheel.left_pulses == 0.0 && rec.wheel.right_pulses == 0.0;
-        init.AddWheel(w);
-        break;
+    if (const ImuSample* imu = rec.get_if<ImuSample>()) {
+      init.AddImu(*imu);
+    } else if (const WheelRecord* wheel = rec.get_if<WheelRecord>()) {
+      const WheelOptions& wo = options.sensors.wheel;
+      WheelMeasurement w;
+      w.t = wheel->t;
+      w.speed = 0.5 * (WheelSpeedFromPulses(wheel->left_pulses, wo.radius, wo.pulses_per_rev, wo.interval) +
+                       WheelSpeedFromPulses(wheel->right_pulses, wo.radius, wo.pulses_per_rev, wo.interval));
+      w.sigma = wo.speed_sigma;
+      w.interval = wo.interval;
+      w.standstill = wheel->left_pulses == 0.0 && wheel->right_pulses == 0.0;
+      init.AddWheel(w);
+    } else if (const GnssRecord* fix = rec.get_if<GnssRecord>()) {  // these drives have no GVEL
+      const GnssRecord& g = *fix;
+      GnssMeasurement m;
+      m.t = g.t;
+      m.p_w = frame.ToEnu({g.lat_deg, g.lon_deg, g.alt_m});
+      m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(options.sensors.gnss.min_sigma) : options.sensors.gnss.sigma_enu;
+      m.heading_valid = g.heading_valid;
+      m.yaw_G = CompassDegToEnuYaw(g.heading_deg);
+      m.sigma_yaw = options.sensors.gnss.heading_sigma;
+      if (m.heading_valid) {
+        const Mat3 R_wG = rec.truth.R_wb() * ExpMat(Vec3(0, 0, options.sensors.gnss.mount_yaw));
+        run.heading_errors_deg.emplace_back(m.t, WrapAngle(m.yaw_G - YawOfXAxis<double>(R_wG)) * kRadToDeg);
       }
-      case SimRecord::Type::kGnss: {
-        const GnssRecord& g = rec.gnss;
-        GnssMeasurement m;
-        m.t = g.t;
-        m.p_w = frame.ToEnu({g.lat_deg, g.lon_deg, g.alt_m});
-        const GnssOptions& go = options.sensors.gnss;
-        m.sigma_w = g.has_sigma ? g.sigma_enu.cwiseMax(go.min_sigma) : go.sigma_enu;
-        m.heading_valid = g.heading_valid;
-        m.yaw_G = CompassDegToEnuYaw(g.heading_deg);
-        m.sigma_yaw = go.heading_sigma;
-        if (m.heading_valid) {
-          const Mat3 R_wG = rec.truth.R_wb() * ExpMat(Vec3(0, 0, go.mount_yaw));
-          run.heading_errors_deg.emplace_back(m.t, WrapAngle(m.yaw_G - YawOfXAxis<double>(R_wG)) * kRadToDeg);
-        }
-        init.AddGnss(m);
-        if (init.done()) {
-          run.done = true;
-          run.result = init.result();
-          run.truth = rec.truth;
-          run.completing_fix = m;
-          run.elapsed_at_done = g.t - sim.start_time;
-          return run;
-        }
-        break;
+      init.AddGnss(m);
+      if (init.done()) {
+        run.done = true;
+        run.result = init.result();
+        run.truth = rec.truth;
+        run.completing_fix = m;
+        run.elapsed_at_done = g.t - sim.start_time;
+        return run;
       }
-      case SimRecord::Type::kGnssVelocity:  // these drives have none
-        break;
     }
   }
   run.diagnosis = init.Diagnosis();

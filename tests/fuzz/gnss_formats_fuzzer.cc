@@ -57,7 +57,7 @@ void ReadAll(Reader which, const std::string& path, const gins::InputOptions& op
       gins::InputIssue issue;
       Require(gins::CheckLogRecord(&copy, &issue) == gins::LineParse::kRecord);
       // Strictly later, but for a GVEL at its fix's time.
-      Require(r.t() > last_t || (r.type == gins::LogRecord::Type::kGnssVelocity && r.t() == last_t));
+      Require(r.t() > last_t || (r.is<gins::GnssVelocityRecord>() && r.t() == last_t));
       Require(r.line >= 1 && r.line <= source->file().lines);
       last_t = r.t();
       ++records;

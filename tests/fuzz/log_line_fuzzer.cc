@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <string_view>
+#include <variant>
 
 #include "core/io/log_reader.h"
 
@@ -13,6 +14,24 @@ namespace {
 
 void Require(bool ok) {
   if (!ok) std::abort();
+}
+
+// An accepted record, per type.
+void RequireSane(const gins::ImuSample& m) { Require(m.gyro.allFinite() && m.acc.allFinite()); }
+
+void RequireSane(const gins::WheelRecord& w) {
+  Require(std::isfinite(w.left_pulses) && std::isfinite(w.right_pulses));
+}
+
+void RequireSane(const gins::GnssRecord& g) {
+  Require(std::abs(g.lat_deg) <= 90.0 && std::abs(g.lon_deg) <= 180.0 && std::isfinite(g.alt_m));
+  Require(g.heading_deg >= 0.0 && g.heading_deg < 360.0);
+  Require(!g.has_sigma || (g.sigma_enu.minCoeff() > 0.0 && g.sigma_enu.allFinite()));
+}
+
+void RequireSane(const gins::GnssVelocityRecord& v) {
+  Require(v.v_enu.allFinite() && v.v_enu.cwiseAbs().maxCoeff() <= 1000.0);
+  Require(!v.has_sigma || (v.sigma_enu.minCoeff() > 0.0 && v.sigma_enu.allFinite()));
 }
 
 }  // namespace
@@ -30,25 +49,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       break;
     case gins::LineParse::kRecord:
       Require(std::isfinite(record.t()) && record.t() > 0.0);
-      switch (record.type) {
-        case gins::LogRecord::Type::kImu:
-          Require(record.imu.gyro.allFinite() && record.imu.acc.allFinite());
-          break;
-        case gins::LogRecord::Type::kWheel:
-          Require(std::isfinite(record.wheel.left_pulses) && std::isfinite(record.wheel.right_pulses));
-          break;
-        case gins::LogRecord::Type::kGnssVelocity:
-          Require(record.gnss_velocity.v_enu.allFinite() && record.gnss_velocity.v_enu.cwiseAbs().maxCoeff() <= 1000.0);
-          Require(!record.gnss_velocity.has_sigma || (record.gnss_velocity.sigma_enu.minCoeff() > 0.0 && record.gnss_velocity.sigma_enu.allFinite()));
-          break;
-        case gins::LogRecord::Type::kGnss: {
-          const gins::GnssRecord& g = record.gnss;
-          Require(std::abs(g.lat_deg) <= 90.0 && std::abs(g.lon_deg) <= 180.0 && std::isfinite(g.alt_m));
-          Require(g.heading_deg >= 0.0 && g.heading_deg < 360.0);
-          Require(!g.has_sigma || (g.sigma_enu.minCoeff() > 0.0 && g.sigma_enu.allFinite()));
-          break;
-        }
-      }
+      std::visit([](const auto& m) { RequireSane(m); }, record.data);
       break;
   }
   return 0;

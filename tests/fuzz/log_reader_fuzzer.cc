@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <numeric>
 #include <string>
 
 #include "core/io/log_reader.h"
@@ -31,7 +32,7 @@ void ReadAll(const std::string& path, const gins::InputOptions& options) {
       ++records;
     }
     const gins::ReadStats& s = reader.stats();
-    Require(s.imu + s.wheel + s.gnss == records);
+    Require(std::accumulate(s.records.begin(), s.records.end(), uint64_t{0}) == records);
     uint64_t listed = 0;
     for (const auto& [reason, lines] : s.skipped_lines) {
       Require(lines.size() == s.skipped.at(reason));

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "config/config_loader.h"
@@ -39,24 +40,7 @@ class Encoder {
       if (std::abs(kSteps[k] - dt) < std::abs(kSteps[code] - dt)) code = k;
     }
     const uint8_t param = static_cast<uint8_t>(code << 4);
-    switch (r.type) {
-      case LogRecord::Type::kImu:
-        AddImu(r.imu, param);
-        break;
-      case LogRecord::Type::kWheel:
-        Put(param | kOpOdom);
-        Put24(static_cast<int32_t>(r.wheel.left_pulses));
-        Put24(static_cast<int32_t>(r.wheel.right_pulses));
-        break;
-      case LogRecord::Type::kGnss:
-        AddGnss(r.gnss, param);
-        break;
-      case LogRecord::Type::kGnssVelocity:
-        Put(param | kOpGvel);
-        Put(0);
-        for (int i = 0; i < 3; ++i) Put16(Cubic16Inverse(r.gnss_velocity.v_enu[i], log_limits::kMaxAbsSpeed));
-        break;
-    }
+    std::visit([this, param](const auto& m) { Encode(m, param); }, r.data);
     t_ += kSteps[code];
   }
 
@@ -73,7 +57,7 @@ class Encoder {
     }
   }
 
-  void AddImu(const ImuSample& s, uint8_t param) {
+  void Encode(const ImuSample& s, uint8_t param) {
     std::array<long, 6> d;
     bool small = true;
     for (int i = 0; i < 3; ++i) {
@@ -103,7 +87,19 @@ class Encoder {
     }
   }
 
-  void AddGnss(const GnssRecord& g, uint8_t param) {
+  void Encode(const WheelRecord& w, uint8_t param) {
+    Put(param | kOpOdom);
+    Put24(static_cast<int32_t>(w.left_pulses));
+    Put24(static_cast<int32_t>(w.right_pulses));
+  }
+
+  void Encode(const GnssVelocityRecord& v, uint8_t param) {
+    Put(param | kOpGvel);
+    Put(0);
+    for (int i = 0; i < 3; ++i) Put16(Cubic16Inverse(v.v_enu[i], log_limits::kMaxAbsSpeed));
+  }
+
+  void Encode(const GnssRecord& g, uint8_t param) {
     Put(param | kOpGnss);
     Put(static_cast<uint8_t>((g.heading_valid ? 1 : 0) | (g.has_sigma ? 2 : 0)));  // relative, mm
     const Vec3 p = frame_.ToEnu({g.lat_deg, g.lon_deg, g.alt_m}) * 1e3;

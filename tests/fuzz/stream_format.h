@@ -44,6 +44,7 @@
 #include <deque>
 #include <memory>
 #include <string>
+#include <variant>
 
 #include "config/options.h"
 #include "core/geodesy.h"
@@ -151,7 +152,7 @@ class StreamDecoder {
   std::deque<LogRecord> queue_;
   size_t emitted_ = 0;
   double t_ = 0.0;                  // newest time stamp
-  std::array<double, LogRecord::kNumTypes> last_t_;  // per type, -1: none yet
+  std::array<double, kNumRecordTypes> last_t_;  // per type, -1: none yet
   int burst_ = 0;
   double burst_t_ = 0.0;
   ImuSample last_imu_;              // in the log's IMU axes
@@ -236,22 +237,9 @@ inline void StreamDecoder::Emit(LogRecord r, double t) {
     t = burst_t_;
     --burst_;
   }
-  const size_t k = static_cast<size_t>(r.type);
+  const size_t k = r.type_index();
   if (!(t >= t_) || last_t_[k] == t) return;  // out_of_order, duplicate
-  switch (r.type) {
-    case LogRecord::Type::kImu:
-      r.imu.t = t;
-      break;
-    case LogRecord::Type::kWheel:
-      r.wheel.t = t;
-      break;
-    case LogRecord::Type::kGnss:
-      r.gnss.t = t;
-      break;
-    case LogRecord::Type::kGnssVelocity:
-      r.gnss_velocity.t = t;
-      break;
-  }
+  r.set_t(t);
   t_ = t;
   last_t_[k] = t;
   queue_.push_back(r);
@@ -319,25 +307,24 @@ inline bool Plausible(GeodeticPoint* g) {
 inline void StreamDecoder::RecordOp(Op op, double dt) {
   LogRecord r;
   if (op == kOpImu || op == kOpImuDelta) {
-    r.type = LogRecord::Type::kImu;
-    r.imu = last_imu_;
+    ImuSample& imu = r.data.emplace<ImuSample>(last_imu_);
     for (int i = 0; i < 3; ++i) {
-      r.imu.gyro[i] = op == kOpImu ? Cubic16(in_.I16(), log_limits::kMaxAbsGyro)
-                                   : std::clamp(r.imu.gyro[i] + kImuDeltaGyro * in_.I8(), -log_limits::kMaxAbsGyro,
-                                                log_limits::kMaxAbsGyro);
+      imu.gyro[i] = op == kOpImu ? Cubic16(in_.I16(), log_limits::kMaxAbsGyro)
+                                 : std::clamp(imu.gyro[i] + kImuDeltaGyro * in_.I8(), -log_limits::kMaxAbsGyro,
+                                              log_limits::kMaxAbsGyro);
     }
     for (int i = 0; i < 3; ++i) {
-      r.imu.acc[i] = op == kOpImu ? Cubic16(in_.I16(), log_limits::kMaxAbsAcc)
-                                  : std::clamp(r.imu.acc[i] + kImuDeltaAcc * in_.I8(), -log_limits::kMaxAbsAcc,
-                                               log_limits::kMaxAbsAcc);
+      imu.acc[i] = op == kOpImu ? Cubic16(in_.I16(), log_limits::kMaxAbsAcc)
+                                : std::clamp(imu.acc[i] + kImuDeltaAcc * in_.I8(), -log_limits::kMaxAbsAcc,
+                                             log_limits::kMaxAbsAcc);
     }
-    last_imu_ = r.imu;
+    last_imu_ = imu;
   } else if (op == kOpOdom) {
-    r.type = LogRecord::Type::kWheel;
-    r.wheel.left_pulses = in_.I24();
-    r.wheel.right_pulses = in_.I24();
+    WheelRecord& wheel = r.data.emplace<WheelRecord>();
+    wheel.left_pulses = in_.I24();
+    wheel.right_pulses = in_.I24();
   } else if (op == kOpGnss) {
-    r.type = LogRecord::Type::kGnss;
+    GnssRecord& fix = r.data.emplace<GnssRecord>();
     const uint8_t flags = in_.U8();
     const int32_t a = in_.I32(), b = in_.I32(), c = in_.I32();
     GeodeticPoint g;
@@ -349,20 +336,20 @@ inline void StreamDecoder::RecordOp(Op op, double dt) {
       g = base_frame_->ToGeodetic(unit * Vec3(a, b, c));
     }
     const double heading = in_.U16() * (360.0 / 65536.0);
-    r.gnss.heading_valid = flags & 1;
-    r.gnss.heading_deg = r.gnss.heading_valid ? heading : 0.0;
-    r.gnss.has_sigma = flags & 2;
-    if (r.gnss.has_sigma) r.gnss.sigma_enu = Vec3(GnssSigma(in_.U8()), GnssSigma(in_.U8()), GnssSigma(in_.U8()));
+    fix.heading_valid = flags & 1;
+    fix.heading_deg = fix.heading_valid ? heading : 0.0;
+    fix.has_sigma = flags & 2;
+    if (fix.has_sigma) fix.sigma_enu = Vec3(GnssSigma(in_.U8()), GnssSigma(in_.U8()), GnssSigma(in_.U8()));
     if (!Plausible(&g)) return;
-    r.gnss.lat_deg = g.lat_deg;
-    r.gnss.lon_deg = g.lon_deg;
-    r.gnss.alt_m = g.alt_m;
+    fix.lat_deg = g.lat_deg;
+    fix.lon_deg = g.lon_deg;
+    fix.alt_m = g.alt_m;
   } else {
-    r.type = LogRecord::Type::kGnssVelocity;
+    GnssVelocityRecord& velocity = r.data.emplace<GnssVelocityRecord>();
     const uint8_t flags = in_.U8();
-    for (int i = 0; i < 3; ++i) r.gnss_velocity.v_enu[i] = Cubic16(in_.I16(), log_limits::kMaxAbsSpeed);
-    r.gnss_velocity.has_sigma = flags & 1;
-    if (r.gnss_velocity.has_sigma) r.gnss_velocity.sigma_enu = Vec3(GvelSigma(in_.U8()), GvelSigma(in_.U8()), GvelSigma(in_.U8()));
+    for (int i = 0; i < 3; ++i) velocity.v_enu[i] = Cubic16(in_.I16(), log_limits::kMaxAbsSpeed);
+    velocity.has_sigma = flags & 1;
+    if (velocity.has_sigma) velocity.sigma_enu = Vec3(GvelSigma(in_.U8()), GvelSigma(in_.U8()), GvelSigma(in_.U8()));
   }
   Emit(r, t_ + dt);
 }
@@ -395,9 +382,7 @@ inline void StreamDecoder::VehicleSample(uint8_t sensors, double accel, double y
   last_imu_.gyro = (R_imu_b * gyro_b).cwiseMax(-log_limits::kMaxAbsGyro).cwiseMin(log_limits::kMaxAbsGyro);
   last_imu_.acc = (R_imu_b * acc_b).cwiseMax(-log_limits::kMaxAbsAcc).cwiseMin(log_limits::kMaxAbsAcc);
   const double imu_t = T + Noise(jitter_);
-  LogRecord imu;
-  imu.type = LogRecord::Type::kImu;
-  imu.imu = last_imu_;
+  const LogRecord imu{last_imu_};
   const bool with_imu = !(mask_ & 1);
   // In time order: the jittered IMU stamp may fall before or after the other sensors' epoch T.
   if (with_imu && imu_t <= T) Emit(imu, imu_t);
@@ -419,10 +404,8 @@ inline void StreamDecoder::VehicleOdom(double t) {
   if (wheel_fault_ == 1) return;  // silent
   double pulses = wheel_fault_ == 2 ? 0.0 : car_.speed * w.interval * w.pulses_per_rev / (2.0 * kPi * w.radius);
   if (wheel_fault_ == 3) pulses *= 2.0;
-  LogRecord r;
-  r.type = LogRecord::Type::kWheel;
-  r.wheel.left_pulses = r.wheel.right_pulses = std::round(std::min(pulses, log_limits::kMaxAbsPulses - 1.0));
-  Emit(r, t);
+  const double counted = std::round(std::min(pulses, log_limits::kMaxAbsPulses - 1.0));
+  Emit({WheelRecord{0.0, counted, counted}}, t);
 }
 
 inline void StreamDecoder::VehicleFix(double t, uint8_t sensors) {
@@ -430,61 +413,58 @@ inline void StreamDecoder::VehicleFix(double t, uint8_t sensors) {
   GeodeticPoint g = base_frame_->ToGeodetic(car_.p + q * options_.sensors.gnss.lever_b + car_.jump);
   if (!Plausible(&g)) return;
   LogRecord r;
-  r.type = LogRecord::Type::kGnss;
-  r.gnss.lat_deg = g.lat_deg;
-  r.gnss.lon_deg = g.lon_deg;
-  r.gnss.alt_m = g.alt_m;
-  r.gnss.has_sigma = true;
-  r.gnss.sigma_enu = Vec3(0.02, 0.02, 0.03);
-  r.gnss.heading_valid = (sensors & 4) && heading_fault_ != 2;
-  if (r.gnss.heading_valid) {
-    const double mount_yaw = options_.sensors.gnss.mount_yaw;
-    double heading = EnuYawToCompassDeg(car_.yaw + mount_yaw) + (heading_fault_ == 3 ? 180.0 : 0.0);
+  GnssRecord& fix = r.data.emplace<GnssRecord>();
+  fix.lat_deg = g.lat_deg;
+  fix.lon_deg = g.lon_deg;
+  fix.alt_m = g.alt_m;
+  fix.has_sigma = true;
+  fix.sigma_enu = Vec3(0.02, 0.02, 0.03);
+  fix.heading_valid = (sensors & 4) && heading_fault_ != 2;
+  if (fix.heading_valid) {
+    double heading = EnuYawToCompassDeg(car_.yaw + options_.sensors.gnss.mount_yaw) + (heading_fault_ == 3 ? 180.0 : 0.0);
     if (heading_fault_ == 1) {
       if (frozen_heading_ < 0.0) frozen_heading_ = heading;
       heading = frozen_heading_;
     }
     heading = std::fmod(heading, 360.0);
-    r.gnss.heading_deg = heading >= 0.0 && heading < 360.0 ? heading : 0.0;
+    fix.heading_deg = heading >= 0.0 && heading < 360.0 ? heading : 0.0;
   }
   Emit(r, t);
   if ((sensors & 8) && !(mask_ & 8)) {
-    LogRecord v;
-    v.type = LogRecord::Type::kGnssVelocity;
-    v.gnss_velocity.v_enu = car_.speed * Vec3(std::cos(car_.yaw), std::sin(car_.yaw), 0.0);
-    Emit(v, t);
+    GnssVelocityRecord v;
+    v.v_enu = car_.speed * Vec3(std::cos(car_.yaw), std::sin(car_.yaw), 0.0);
+    Emit({v}, t);
   }
 }
 
 // The record as a line of the gins log format (all digits), for reproducing an input with `gins run`.
+inline void PrintLine(const ImuSample& m, char* buf, size_t size) {
+  std::snprintf(buf, size, "IMU %.17g %.17g %.17g %.17g %.17g %.17g %.17g", m.t, m.gyro.x(), m.gyro.y(),
+                       m.gyro.z(), m.acc.x(), m.acc.y(), m.acc.z());
+}
+
+inline void PrintLine(const WheelRecord& w, char* buf, size_t size) {
+  std::snprintf(buf, size, "ODOM %.17g %.17g %.17g", w.t, w.left_pulses, w.right_pulses);
+}
+
+inline void PrintLine(const GnssRecord& g, char* buf, size_t size) {
+  const int n = std::snprintf(buf, size, "GNSS %.17g %.17g %.17g %.17g %.17g %d", g.t, g.lat_deg, g.lon_deg, g.alt_m,
+                              g.heading_deg, g.heading_valid ? 1 : 0);
+  if (g.has_sigma) {
+    std::snprintf(buf + n, size - n, " %.17g %.17g %.17g", g.sigma_enu.x(), g.sigma_enu.y(), g.sigma_enu.z());
+  }
+}
+
+inline void PrintLine(const GnssVelocityRecord& v, char* buf, size_t size) {
+  const int n = std::snprintf(buf, size, "GVEL %.17g %.17g %.17g %.17g", v.t, v.v_enu.x(), v.v_enu.y(), v.v_enu.z());
+  if (v.has_sigma) {
+    std::snprintf(buf + n, size - n, " %.17g %.17g %.17g", v.sigma_enu.x(), v.sigma_enu.y(), v.sigma_enu.z());
+  }
+}
+
 inline std::string ToLogLine(const LogRecord& r) {
   char buf[320];
-  switch (r.type) {
-    case LogRecord::Type::kImu:
-      std::snprintf(buf, sizeof(buf), "IMU %.17g %.17g %.17g %.17g %.17g %.17g %.17g", r.imu.t, r.imu.gyro.x(),
-                    r.imu.gyro.y(), r.imu.gyro.z(), r.imu.acc.x(), r.imu.acc.y(), r.imu.acc.z());
-      break;
-    case LogRecord::Type::kWheel:
-      std::snprintf(buf, sizeof(buf), "ODOM %.17g %.17g %.17g", r.wheel.t, r.wheel.left_pulses, r.wheel.right_pulses);
-      break;
-    case LogRecord::Type::kGnss: {
-      const GnssRecord& g = r.gnss;
-      int n = std::snprintf(buf, sizeof(buf), "GNSS %.17g %.17g %.17g %.17g %.17g %d", g.t, g.lat_deg, g.lon_deg,
-                            g.alt_m, g.heading_deg, g.heading_valid ? 1 : 0);
-      if (g.has_sigma) {
-        std::snprintf(buf + n, sizeof(buf) - n, " %.17g %.17g %.17g", g.sigma_enu.x(), g.sigma_enu.y(), g.sigma_enu.z());
-      }
-      break;
-    }
-    case LogRecord::Type::kGnssVelocity: {
-      const GnssVelocityRecord& v = r.gnss_velocity;
-      int n = std::snprintf(buf, sizeof(buf), "GVEL %.17g %.17g %.17g %.17g", v.t, v.v_enu.x(), v.v_enu.y(), v.v_enu.z());
-      if (v.has_sigma) {
-        std::snprintf(buf + n, sizeof(buf) - n, " %.17g %.17g %.17g", v.sigma_enu.x(), v.sigma_enu.y(), v.sigma_enu.z());
-      }
-      break;
-    }
-  }
+  std::visit([&buf](const auto& m) { PrintLine(m, buf, sizeof(buf)); }, r.data);
   return buf;
 }
 

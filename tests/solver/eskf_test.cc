@@ -47,7 +47,7 @@ DriveResult RunDrive(const SimOptions& sim, const Options& options) {
   SimRecord rec;
   while (simulator.Next(&rec)) {
     test::FeedSession(&session, rec);
-    if (rec.type != SimRecord::Type::kImu || !session.initialized()) continue;
+    if (!rec.is<ImuSample>() || !session.initialized()) continue;
     const NavState& x = eskf->state();
     const NavState& truth = rec.truth;
     const Vec3 dp = x.p_wb - truth.p_wb;

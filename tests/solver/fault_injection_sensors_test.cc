@@ -51,7 +51,7 @@ TEST(FaultInjection, GnssJumpOfOneKilometreThatLasts) {
   const double t0 = sim.start_time + 60.0;
   const Vec3 jump(600.0, -800.0, 0.0);
   const DriveRun run = test::RunDriveThroughSession(sim, test::TestRunOptions(sim), Editing([&](SimRecord* r) {
-    if (r->type == SimRecord::Type::kGnss && r->t() >= t0) test::Displace(sim, jump, &r->gnss);
+    if (r->is<GnssRecord>() && r->t() >= t0) test::Displace(sim, jump, &r->get<GnssRecord>());
     return true;
   }));
   ASSERT_TRUE(run.initialized);
@@ -76,7 +76,8 @@ TEST(FaultInjection, GnssJumpOfOneKilometreThatComesBack) {
     const SimOptions sim = FaultDrive(22, 130.0);
     const double t0 = sim.start_time + 60.0, t1 = t0 + d;
     const DriveRun run = test::RunDriveThroughSession(sim, test::TestRunOptions(sim), Editing([&](SimRecord* r) {
-      if (r->type == SimRecord::Type::kGnss && r->t() >= t0 && r->t() < t1) test::Displace(sim, Vec3(0.0, 1000.0, 0.0), &r->gnss);
+      GnssRecord* fix = r->get_if<GnssRecord>();
+      if (fix && r->t() >= t0 && r->t() < t1) test::Displace(sim, Vec3(0.0, 1000.0, 0.0), fix);
       return true;
     }));
     ASSERT_TRUE(run.initialized);
@@ -95,7 +96,7 @@ TEST(FaultInjection, WheelsStopReporting) {
   const SimOptions sim = FaultDrive(23, 155.0, /*keep_outage=*/true);
   const double t0 = sim.start_time + 40.0, outage = sim.start_time + 125.0, outage_end = outage + 20.0;
   const DriveRun run = test::RunDriveThroughSession(sim, test::TestRunOptions(sim), Editing([&](SimRecord* r) {
-    return !(r->type == SimRecord::Type::kWheel && r->t() >= t0);
+    return !(r->is<WheelRecord>() && r->t() >= t0);
   }));
   ASSERT_TRUE(run.initialized);
   test::ExpectSaneOutputs(run);
@@ -112,10 +113,10 @@ TEST(FaultInjection, HeadingValidButConstant) {
   const SimOptions sim = FaultDrive(24, 120.0);
   auto frozen = std::make_shared<double>(-1.0);
   const DriveRun run = test::RunDriveThroughSession(sim, test::TestRunOptions(sim), Editing([&](SimRecord* r) {
-    if (r->type == SimRecord::Type::kGnss) {
-      if (*frozen < 0.0 && r->gnss.heading_valid) *frozen = r->gnss.heading_deg;
-      r->gnss.heading_valid = true;
-      r->gnss.heading_deg = *frozen < 0.0 ? 0.0 : *frozen;
+    if (r->is<GnssRecord>()) {
+      if (*frozen < 0.0 && r->get<GnssRecord>().heading_valid) *frozen = r->get<GnssRecord>().heading_deg;
+      r->get<GnssRecord>().heading_valid = true;
+      r->get<GnssRecord>().heading_deg = *frozen < 0.0 ? 0.0 : *frozen;
     }
     return true;
   }));
@@ -163,7 +164,7 @@ TEST(FaultInjection, LongLoggerPauseWithoutHeading) {
   std::vector<double> fixes;  // the times of the fixes the session got
   const DriveRun run = test::RunDriveThroughSession(sim, options, Editing([&](SimRecord* r) {
     const bool kept = !(r->t() > t0 && r->t() < t1);
-    if (kept && r->type == SimRecord::Type::kGnss) fixes.push_back(r->t());
+    if (kept && r->is<GnssRecord>()) fixes.push_back(r->t());
     return kept;
   }));
   ASSERT_TRUE(run.initialized);
@@ -189,7 +190,8 @@ TEST(FaultInjection, WheelsCountZeroWhileMoving) {
   const SimOptions sim = FaultDrive(27, 155.0, /*keep_outage=*/true);
   const double t0 = sim.start_time + 40.0, outage = sim.start_time + 125.0, outage_end = outage + 20.0;
   const DriveRun run = test::RunDriveThroughSession(sim, test::TestRunOptions(sim), Editing([&](SimRecord* r) {
-    if (r->type == SimRecord::Type::kWheel && r->t() >= t0) r->wheel.left_pulses = r->wheel.right_pulses = 0.0;
+    WheelRecord* wheel = r->get_if<WheelRecord>();
+    if (wheel && r->t() >= t0) wheel->left_pulses = wheel->right_pulses = 0.0;
     return true;
   }));
   ASSERT_TRUE(run.initialized);

@@ -33,7 +33,7 @@ using test::FaultDrive;
 using test::kFaultBound;
 using test::RecordHook;
 
-bool IsImu(const SimRecord& r) { return r.type == SimRecord::Type::kImu; }
+bool IsImu(const SimRecord& r) { return r.is<ImuSample>(); }
 
 // A healthy run of the drive: the reference the bounds above are checked against.
 TEST(FaultInjection, HealthyDriveStaysWithinTheBound) {
@@ -179,7 +179,7 @@ TEST(FaultInjection, TimeStampJitter) {
   const DriveRun run = test::RunDriveThroughSession(
       sim, test::TestRunOptions(sim), [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline&) {
         SimRecord j = r;
-        const bool logger_stamped = r.type == SimRecord::Type::kImu || r.type == SimRecord::Type::kWheel;
+        const bool logger_stamped = r.is<ImuSample>() || r.is<WheelRecord>();
         if (logger_stamped && r.t() >= t0 && r.t() < t1) test::SetTime(&j, r.t() + jitter(rng));
         if (reader.Accept(j)) feed(j);
       });
@@ -203,7 +203,7 @@ TEST(FaultInjection, GnssBeforeTheFirstImuSample) {
   const SimOptions sim = FaultDrive(17, 100.0);
   const double t0 = sim.start_time + 10.0;
   const DriveRun run = test::RunDriveThroughSession(
-      sim, test::TestRunOptions(sim), Dropping([&](const SimRecord& r) { return r.type != SimRecord::Type::kGnss && r.t() < t0; }));
+      sim, test::TestRunOptions(sim), Dropping([&](const SimRecord& r) { return !r.is<GnssRecord>() && r.t() < t0; }));
   ASSERT_TRUE(run.initialized);
   EXPECT_GE(run.init_t, t0 + 2.0);  // a standstill of init.static_duration_s after the IMU starts
   test::ExpectSaneOutputs(run);

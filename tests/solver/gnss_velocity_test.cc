@@ -30,11 +30,11 @@ test::RecordHook WithGvel(double sigma_v, const Vec3& lever_b) {
   auto omega_b = std::make_shared<Vec3>(Vec3::Zero());
   return [=](const SimRecord& rec, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline& session) {
     feed(rec);
-    if (rec.type == SimRecord::Type::kImu) *omega_b = rec.imu.gyro - rec.truth.bg;
-    if (rec.type != SimRecord::Type::kGnss) return;
+    if (rec.is<ImuSample>()) *omega_b = rec.get<ImuSample>().gyro - rec.truth.bg;
+    if (!rec.is<GnssRecord>()) return;
     std::normal_distribution<double> n(0.0, sigma_v);
     GnssVelocityRecord g;
-    g.t = rec.gnss.t;
+    g.t = rec.get<GnssRecord>().t;
     g.v_enu = rec.truth.v_w + rec.truth.q_wb * omega_b->cross(lever_b) + Vec3(n(*rng), n(*rng), n(*rng));
     g.has_sigma = true;
     g.sigma_enu = Vec3::Constant(sigma_v);

@@ -130,9 +130,9 @@ TEST(InitializationPaths, StaticWithWheelsNoHeading) {
 void ExpectOutputFromTheFirstFix(const SimOptions& sim, const Options& options, const char* name,
                                  double outlier_t = 0.0) {
   const test::RecordHook hook = [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed, EstimatorPipeline&) {
-    if (r.type != SimRecord::Type::kGnss || std::abs(r.gnss.t - outlier_t) > 1e-6) return feed(r);
+    if (!r.is<GnssRecord>() || std::abs(r.get<GnssRecord>().t - outlier_t) > 1e-6) return feed(r);
     SimRecord moved = r;
-    moved.gnss.lat_deg += 20.0 / 111111.0;
+    moved.get<GnssRecord>().lat_deg += 20.0 / 111111.0;
     feed(moved);
   };
   const test::DriveRun run = test::RunDriveThroughSession(sim, options, hook, true, true, true);
@@ -206,7 +206,7 @@ TEST(InitializationPaths, AWindowThatDoesNotReachTheFirstFixEveryOutputFromTheFi
   const double drop0 = sim.start_time + 20.8, drop1 = drop0 + 0.6;
   const test::RecordHook hook = [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed,
                                     EstimatorPipeline&) {
-    if (r.type == SimRecord::Type::kImu && r.imu.t >= drop0 && r.imu.t < drop1) return;
+    if (r.is<ImuSample>() && r.get<ImuSample>().t >= drop0 && r.get<ImuSample>().t < drop1) return;
     feed(r);
   };
   const test::DriveRun run = test::RunDriveThroughSession(sim, options, hook, true, true, true);

@@ -30,8 +30,8 @@ Drive Simulate(const SimOptions& sim, double t_end, const Vec3& extra_bg) {
   d.earth = EarthModel::Rotating(simulator.truth().frame());
   SimRecord r;
   while (simulator.Next(&r) && r.t() <= t_end) {
-    if (r.type != SimRecord::Type::kImu) continue;
-    ImuSample s = r.imu;
+    if (!r.is<ImuSample>()) continue;
+    ImuSample s = r.get<ImuSample>();
     s.gyro += extra_bg;
     d.imu.push_back(s);
     NavState x = r.truth;

@@ -60,8 +60,8 @@ Output RunDrive(const SimOptions& sim, const Options& options, const Edit& edit)
   session.AddEstimator(std::move(smoother));
   SimRecord rec;
   while (simulator.Next(&rec)) {
-    if (rec.type == SimRecord::Type::kImu) {
-      out.truth_t.push_back(rec.imu.t);
+    if (rec.is<ImuSample>()) {
+      out.truth_t.push_back(rec.get<ImuSample>().t);
       out.truth_p.push_back(rec.truth.p_wb);
     }
     if (edit && !edit(&rec)) continue;
@@ -121,9 +121,9 @@ TEST(RobustnessEndToEnd, BurstOfEightWildFixesIsRejectedByBothEstimators) {
     const double burst_start = sim.start_time + 60.0;  // elapsed 60..67 s
     std::vector<double> burst;
     const Output out = RunDrive(sim, options, [&](SimRecord* r) {
-      if (r->type == SimRecord::Type::kGnss && r->gnss.t >= burst_start && burst.size() < 8) {
-        Displace(sim, Vec3(30.0, -40.0, 0.0), &r->gnss);  // 50 m
-        burst.push_back(r->gnss.t);
+      if (r->is<GnssRecord>() && r->get<GnssRecord>().t >= burst_start && burst.size() < 8) {
+        Displace(sim, Vec3(30.0, -40.0, 0.0), &r->get<GnssRecord>());  // 50 m
+        burst.push_back(r->get<GnssRecord>().t);
       }
       return true;
     });
@@ -154,9 +154,9 @@ TEST(RobustnessEndToEnd, AlternatingBurstCostsOnlyTheBurst) {
     const double burst_start = sim.start_time + 60.0;
     std::vector<double> burst;
     const Output out = RunDrive(sim, options, [&](SimRecord* r) {
-      if (r->type == SimRecord::Type::kGnss && r->gnss.t >= burst_start && burst.size() < 8) {
-        Displace(sim, Vec3(0.0, burst.size() % 2 == 0 ? 55.0 : -55.0, 0.0), &r->gnss);
-        burst.push_back(r->gnss.t);
+      if (r->is<GnssRecord>() && r->get<GnssRecord>().t >= burst_start && burst.size() < 8) {
+        Displace(sim, Vec3(0.0, burst.size() % 2 == 0 ? 55.0 : -55.0, 0.0), &r->get<GnssRecord>());
+        burst.push_back(r->get<GnssRecord>().t);
       }
       return true;
     });
@@ -187,7 +187,7 @@ TEST(RobustnessEndToEnd, WatchdogAcceptsAPersistentGnssStep) {
   const double step_t = sim.start_time + 95.0;
   const Vec3 step(30.0, 0.0, 0.0);
   const Output out = RunDrive(sim, options, [&](SimRecord* r) {
-    if (r->type == SimRecord::Type::kGnss && r->gnss.t >= step_t) Displace(sim, step, &r->gnss);
+    if (r->is<GnssRecord>() && r->get<GnssRecord>().t >= step_t) Displace(sim, step, &r->get<GnssRecord>());
     return true;
   });
   for (const auto& [name, stats, states] :
@@ -304,7 +304,7 @@ TEST(RobustnessEndToEnd, ImuGapIsCoastedNotIntegratedBlindly) {
   const Options options = test::TestRunOptions(sim);
   const double gap_start = sim.start_time + 50.0, gap_end = gap_start + 1.5;  // in the left turn
   const Output out = RunDrive(sim, options, [&](SimRecord* r) {
-    return !(r->type == SimRecord::Type::kImu && r->imu.t > gap_start && r->imu.t < gap_end);
+    return !(r->is<ImuSample>() && r->get<ImuSample>().t > gap_start && r->get<ImuSample>().t < gap_end);
   });
   for (const auto& [name, states, stats] : {std::tuple{"eskf", &out.eskf, &out.eskf_stats},
                                              std::tuple{"smoother", &out.smoother, &out.smoother_stats}}) {

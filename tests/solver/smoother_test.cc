@@ -127,12 +127,12 @@ DriveOutput RunDrive(const SimOptions& sim, const Options& options, bool with_es
   SimRecord rec;
   while (simulator.Next(&rec)) {
     test::FeedSession(&session, rec);
-    if (rec.type == SimRecord::Type::kImu) {
-      out.truth.t.push_back(rec.imu.t);
+    if (rec.is<ImuSample>()) {
+      out.truth.t.push_back(rec.get<ImuSample>().t);
       out.truth.x.push_back(rec.truth);
       if (session.initialized()) ++out.imu_after_init;
-    } else if (rec.type == SimRecord::Type::kGnss && rec.gnss_outlier) {
-      out.outlier_times.push_back(rec.gnss.t);
+    } else if (rec.is<GnssRecord>() && rec.gnss_outlier) {
+      out.outlier_times.push_back(rec.get<GnssRecord>().t);
     }
   }
   session.Finish();

@@ -51,7 +51,7 @@ TEST(VehicleSetups, TenHzFixesAreAllUsed) {
   std::vector<double> fixes;
   const test::RecordHook count_fixes = [&](const SimRecord& r, const std::function<void(const SimRecord&)>& feed,
                                            EstimatorPipeline&) {
-    if (r.type == SimRecord::Type::kGnss) fixes.push_back(r.t());
+    if (r.is<GnssRecord>()) fixes.push_back(r.t());
     feed(r);
   };
   const DriveRun run = test::RunDriveThroughSession(sim, test::TestRunOptions(sim), count_fixes);

@@ -12,11 +12,9 @@ namespace gins::api {
 namespace {
 
 LogRecord At(double t, uint64_t tag) {
-  LogRecord r;
-  r.type = LogRecord::Type::kImu;
-  r.imu.t = t;
-  r.line = tag;
-  return r;
+  ImuSample imu;
+  imu.t = t;
+  return {imu, tag};
 }
 
 TEST(ApiReorderBufferTest, SortsAnyOrderWithinTheWindow) {

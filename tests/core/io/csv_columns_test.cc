@@ -71,7 +71,7 @@ TEST_F(Csv, ImuColumnsTakeUnitsSignsAndExactNanosecondStamps) {
   const Read r = ReadText("1700000000123456789,1.0,2.0,-3.0,0.01,0.02,-1.0\n",
                           "t=1:ns,gx=2:deg/s,gy=-3:deg/s,gz=-4:deg/s,ax=5:g,ay=-6:g,az=-7:g", CsvKind::kImu);
   ASSERT_EQ(r.records.size(), 1u);
-  const ImuSample& s = r.records[0].imu;
+  const ImuSample& s = r.records[0].get<ImuSample>();
   EXPECT_EQ(s.t, 1700000000.0 + 0.123456789);
   EXPECT_EQ(s.gyro, Vec3(1.0 * kDegToRad, -2.0 * kDegToRad, 3.0 * kDegToRad));
   EXPECT_EQ(s.acc, Vec3(0.01 * 9.80665, -0.02 * 9.80665, 1.0 * 9.80665));
@@ -85,25 +85,25 @@ TEST_F(Csv, GnssColumnsByHeaderNameWithSigmaHeadingAndVelocity) {
       "t=time,lat=latitude:rad,lon=longitude:rad,h=height,se=s_e,sn=s_n,su=s_u,heading=yaw,ve=v_e,vn=v_n,vu=v_u",
       CsvKind::kGnss);
   ASSERT_EQ(r.records.size(), 4u);
-  const GnssRecord& g = r.records[0].gnss;
+  const GnssRecord& g = r.records[0].get<GnssRecord>();
   EXPECT_EQ(g.t, 1700000000.5);
   EXPECT_EQ(g.lat_deg, 0.5 * kRadToDeg);
   EXPECT_EQ(g.lon_deg, 2.0 * kRadToDeg);
   EXPECT_EQ(g.sigma_enu, Vec3(0.02, 0.03, 0.05));
   EXPECT_FALSE(g.heading_valid);  // an empty heading field: no heading at this fix
-  EXPECT_TRUE(r.records[2].gnss.heading_valid);
-  EXPECT_EQ(r.records[2].gnss.heading_deg, 90.0);
-  EXPECT_EQ(r.records[1].type, LogRecord::Type::kGnssVelocity);
-  EXPECT_EQ(r.records[1].gnss_velocity.v_enu, Vec3(1.0, 2.0, 0.1));
-  EXPECT_FALSE(r.records[1].gnss_velocity.has_sigma);
+  EXPECT_TRUE(r.records[2].get<GnssRecord>().heading_valid);
+  EXPECT_EQ(r.records[2].get<GnssRecord>().heading_deg, 90.0);
+  EXPECT_TRUE(r.records[1].is<GnssVelocityRecord>());
+  EXPECT_EQ(r.records[1].get<GnssVelocityRecord>().v_enu, Vec3(1.0, 2.0, 0.1));
+  EXPECT_FALSE(r.records[1].get<GnssVelocityRecord>().has_sigma);
 }
 
 TEST_F(Csv, WheelColumnsBecomeOdomRecords) {
   const Read r = ReadText("t,l,r\n10.0, 5, 6\n10.1, -5, 7\n", "t=1,left=2,right=3", CsvKind::kWheel);
   ASSERT_EQ(r.records.size(), 2u);
-  EXPECT_EQ(r.records[1].type, LogRecord::Type::kWheel);
-  EXPECT_EQ(r.records[1].wheel.left_pulses, -5.0);
-  EXPECT_EQ(r.records[1].wheel.right_pulses, 7.0);
+  EXPECT_TRUE(r.records[1].is<WheelRecord>());
+  EXPECT_EQ(r.records[1].get<WheelRecord>().left_pulses, -5.0);
+  EXPECT_EQ(r.records[1].get<WheelRecord>().right_pulses, 7.0);
 }
 
 TEST_F(Csv, AColumnTheMapNamesThatIsNotThereIsDamageNamedByLine) {

@@ -57,7 +57,7 @@ Log ReadBack(const std::string& path) {
   Log log;
   for (LogRecord r; reader.Next(&r);) {
     log.records.push_back(r);
-    log.types += "IOGV"[static_cast<int>(r.type)];
+    log.types += "IOGV"[r.type_index()];
   }
   return log;
 }
@@ -92,12 +92,12 @@ TEST_F(GnssConvert, MergesTheFixesIntoTheImuLogInTimeOrderAndDropsItsOwnGnss) {
   // IMU at .00 .25 .50, the fix and its GVEL at .75 after the IMU sample there; at 2.0 IMU, ODOM, fix, GVEL.
   EXPECT_EQ(log.types, "IOIIOIGVIOIIOIIOGVIIOIIO");
   EXPECT_EQ(log.records[4].t(), kT0 + 0.5);
-  EXPECT_EQ(log.records[6].gnss.t, kT0 + 0.75);
-  EXPECT_EQ(log.records[6].gnss.sigma_enu, Vec3(0.02, 0.01, 0.03));
-  EXPECT_EQ(log.records[7].gnss_velocity.v_enu, Vec3(0.25, 0.5, -0.125));
-  EXPECT_EQ(log.records[7].gnss_velocity.sigma_enu, Vec3(0.02, 0.01, 0.03));
-  EXPECT_EQ(log.records[1].wheel.left_pulses, 10.0);
-  EXPECT_EQ(log.records[1].wheel.right_pulses, -11.0);
+  EXPECT_EQ(log.records[6].get<GnssRecord>().t, kT0 + 0.75);
+  EXPECT_EQ(log.records[6].get<GnssRecord>().sigma_enu, Vec3(0.02, 0.01, 0.03));
+  EXPECT_EQ(log.records[7].get<GnssVelocityRecord>().v_enu, Vec3(0.25, 0.5, -0.125));
+  EXPECT_EQ(log.records[7].get<GnssVelocityRecord>().sigma_enu, Vec3(0.02, 0.01, 0.03));
+  EXPECT_EQ(log.records[1].get<WheelRecord>().left_pulses, 10.0);
+  EXPECT_EQ(log.records[1].get<WheelRecord>().right_pulses, -11.0);
   EXPECT_EQ(c.imu.dropped_gnss, 1u);
   EXPECT_EQ(c.imu.dropped_gvel, 1u);
   EXPECT_EQ(c.written[0], 13u);

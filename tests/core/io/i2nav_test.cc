@@ -100,9 +100,9 @@ LogContent ReadLog(const std::string& path) {
   LogContent log;
   LogRecord r;
   while (reader.Next(&r)) {
-    if (r.type == LogRecord::Type::kImu) log.imu.push_back(r.imu);
-    if (r.type == LogRecord::Type::kGnss) log.gnss.push_back(r.gnss);
-    log.order.push_back(r.type == LogRecord::Type::kImu ? 'I' : 'G');
+    if (r.is<ImuSample>()) log.imu.push_back(r.get<ImuSample>());
+    if (r.is<GnssRecord>()) log.gnss.push_back(r.get<GnssRecord>());
+    log.order.push_back(r.is<ImuSample>() ? 'I' : 'G');
   }
   EXPECT_EQ(reader.stats().total_skipped(), 0u);
   return log;

@@ -62,18 +62,18 @@ TEST_F(LogReaderTest, ReadsAllTypesWithValuesAndLineNumbers) {
   const ReadResult r = ReadAll(path);
   ASSERT_EQ(r.records.size(), 5u);
   const LogRecord& imu = r.records[0];
-  EXPECT_EQ(imu.type, LogRecord::Type::kImu);
+  EXPECT_TRUE(imu.is<ImuSample>());
   EXPECT_EQ(imu.line, 1u);
   EXPECT_EQ(imu.t(), 1.0);
-  EXPECT_EQ(imu.imu.gyro, Vec3(0.01, -0.02, 0.03));
-  EXPECT_EQ(imu.imu.acc, Vec3(0.1, -0.2, 9.8));
+  EXPECT_EQ(imu.get<ImuSample>().gyro, Vec3(0.01, -0.02, 0.03));
+  EXPECT_EQ(imu.get<ImuSample>().acc, Vec3(0.1, -0.2, 9.8));
   const LogRecord& wheel = r.records[1];
-  EXPECT_EQ(wheel.type, LogRecord::Type::kWheel);
+  EXPECT_TRUE(wheel.is<WheelRecord>());
   EXPECT_EQ(wheel.line, 2u);
-  EXPECT_EQ(wheel.wheel.left_pulses, 10.0);
-  EXPECT_EQ(wheel.wheel.right_pulses, -12.0);
-  const GnssRecord& g = r.records[2].gnss;
-  EXPECT_EQ(r.records[2].type, LogRecord::Type::kGnss);
+  EXPECT_EQ(wheel.get<WheelRecord>().left_pulses, 10.0);
+  EXPECT_EQ(wheel.get<WheelRecord>().right_pulses, -12.0);
+  const GnssRecord& g = r.records[2].get<GnssRecord>();
+  EXPECT_TRUE(r.records[2].is<GnssRecord>());
   EXPECT_EQ(g.lat_deg, 31.5);
   EXPECT_EQ(g.lon_deg, 120.4);
   EXPECT_EQ(g.alt_m, 10.5);
@@ -81,19 +81,19 @@ TEST_F(LogReaderTest, ReadsAllTypesWithValuesAndLineNumbers) {
   EXPECT_TRUE(g.heading_valid);
   EXPECT_TRUE(g.has_sigma);
   EXPECT_EQ(g.sigma_enu, Vec3(0.02, 0.03, 0.05));
-  const GnssRecord& g2 = r.records[3].gnss;
+  const GnssRecord& g2 = r.records[3].get<GnssRecord>();
   EXPECT_EQ(g2.t, 1.1);
   EXPECT_FALSE(g2.has_sigma);
   EXPECT_DOUBLE_EQ(g2.heading_deg, 350.0);  // -10 normalised into [0, 360)
   EXPECT_EQ(g2.lat_deg, -31.5);
   // An invalid heading is a placeholder: any value is accepted and not passed on.
-  const GnssRecord& g3 = r.records[4].gnss;
+  const GnssRecord& g3 = r.records[4].get<GnssRecord>();
   EXPECT_FALSE(g3.heading_valid);
   EXPECT_EQ(g3.heading_deg, 0.0);
   EXPECT_EQ(r.stats.lines, 5u);
-  EXPECT_EQ(r.stats.imu, 1u);
-  EXPECT_EQ(r.stats.wheel, 1u);
-  EXPECT_EQ(r.stats.gnss, 3u);
+  EXPECT_EQ(CountOf<ImuSample>(r.stats.records), 1u);
+  EXPECT_EQ(CountOf<WheelRecord>(r.stats.records), 1u);
+  EXPECT_EQ(CountOf<GnssRecord>(r.stats.records), 3u);
   EXPECT_EQ(r.stats.total_skipped(), 0u);
   EXPECT_TRUE(r.stats.examples.empty());
 }
@@ -101,13 +101,13 @@ TEST_F(LogReaderTest, ReadsAllTypesWithValuesAndLineNumbers) {
 TEST_F(LogReaderTest, GnssVelocityWithAndWithoutSigma) {
   const ReadResult r = ReadAll(Write("log.txt", Imu("1.0") + "\nGVEL 1.0 3.5 -1.25 0.5\nGVEL 2.0 1 2 3 0.1 0.2 0.3\n"));
   ASSERT_EQ(r.records.size(), 3u);
-  EXPECT_EQ(r.stats.gnss_velocity, 2u);
-  ASSERT_EQ(r.records[1].type, LogRecord::Type::kGnssVelocity);
-  EXPECT_EQ(r.records[1].gnss_velocity.t, 1.0);
-  EXPECT_EQ(r.records[1].gnss_velocity.v_enu, Vec3(3.5, -1.25, 0.5));
-  EXPECT_FALSE(r.records[1].gnss_velocity.has_sigma);
-  EXPECT_TRUE(r.records[2].gnss_velocity.has_sigma);
-  EXPECT_EQ(r.records[2].gnss_velocity.sigma_enu, Vec3(0.1, 0.2, 0.3));
+  EXPECT_EQ(CountOf<GnssVelocityRecord>(r.stats.records), 2u);
+  ASSERT_TRUE(r.records[1].is<GnssVelocityRecord>());
+  EXPECT_EQ(r.records[1].get<GnssVelocityRecord>().t, 1.0);
+  EXPECT_EQ(r.records[1].get<GnssVelocityRecord>().v_enu, Vec3(3.5, -1.25, 0.5));
+  EXPECT_FALSE(r.records[1].get<GnssVelocityRecord>().has_sigma);
+  EXPECT_TRUE(r.records[2].get<GnssVelocityRecord>().has_sigma);
+  EXPECT_EQ(r.records[2].get<GnssVelocityRecord>().sigma_enu, Vec3(0.1, 0.2, 0.3));
   EXPECT_EQ(r.records[2].line, 3u);
 }
 
@@ -125,11 +125,11 @@ TEST_F(LogReaderTest, CommentsBlankLinesCrlfTabsAndWhitespace) {
   const ReadResult r = ReadAll(path);
   ASSERT_EQ(r.records.size(), 3u);
   EXPECT_EQ(r.records[0].line, 4u);
-  EXPECT_EQ(r.records[0].imu.acc.z(), 9.8);
+  EXPECT_EQ(r.records[0].get<ImuSample>().acc.z(), 9.8);
   EXPECT_EQ(r.records[1].line, 5u);
-  EXPECT_EQ(r.records[1].wheel.right_pulses, -12.0);
+  EXPECT_EQ(r.records[1].get<WheelRecord>().right_pulses, -12.0);
   EXPECT_EQ(r.records[2].line, 7u);
-  EXPECT_TRUE(r.records[2].gnss.heading_valid);
+  EXPECT_TRUE(r.records[2].get<GnssRecord>().heading_valid);
   EXPECT_EQ(r.stats.lines, 9u);
   // A BOM is only skipped at the start of the file; elsewhere it is an unknown record type.
   EXPECT_EQ(r.stats.skipped.at("unknown_type"), 1u);
@@ -149,11 +149,11 @@ TEST_F(LogReaderTest, NumberSyntaxAcceptedLikeStrtod) {
                                      "GNSS 3 -90 180 99999.9 -360 1\n"
                                      "IMU 3 35 -35 0 200 -200 0\n"));
   ASSERT_EQ(r.records.size(), 4u) << (r.stats.examples.empty() ? "" : r.stats.examples[0].detail);
-  EXPECT_EQ(r.records[0].imu.t, 1.5);
-  EXPECT_EQ(r.records[0].imu.gyro, Vec3(0.0, 0.5, -0.0));
-  EXPECT_EQ(r.records[0].imu.acc, Vec3(10.0, -25.0, 35.0));
-  EXPECT_EQ(r.records[1].gnss.heading_deg, 0.0);
-  EXPECT_EQ(r.records[2].gnss.heading_deg, 0.0);
+  EXPECT_EQ(r.records[0].get<ImuSample>().t, 1.5);
+  EXPECT_EQ(r.records[0].get<ImuSample>().gyro, Vec3(0.0, 0.5, -0.0));
+  EXPECT_EQ(r.records[0].get<ImuSample>().acc, Vec3(10.0, -25.0, 35.0));
+  EXPECT_EQ(r.records[1].get<GnssRecord>().heading_deg, 0.0);
+  EXPECT_EQ(r.records[2].get<GnssRecord>().heading_deg, 0.0);
 }
 
 TEST_F(LogReaderTest, GzipDetectedByMagicBytesNotByName) {
@@ -166,11 +166,11 @@ TEST_F(LogReaderTest, GzipDetectedByMagicBytesNotByName) {
   ASSERT_EQ(plain.records.size(), 3u);
   ASSERT_EQ(gz.records.size(), 3u);
   for (size_t i = 0; i < 3; ++i) {
-    EXPECT_EQ(gz.records[i].type, plain.records[i].type);
+    EXPECT_EQ(gz.records[i].type_index(), plain.records[i].type_index());
     EXPECT_EQ(gz.records[i].line, plain.records[i].line);
     EXPECT_EQ(gz.records[i].t(), plain.records[i].t());
   }
-  EXPECT_EQ(gz.records[2].gnss.sigma_enu, Vec3(1, 2, 3));
+  EXPECT_EQ(gz.records[2].get<GnssRecord>().sigma_enu, Vec3(1, 2, 3));
   EXPECT_EQ(gz.stats.total_skipped(), 0u);
   EXPECT_EQ(plain.stats.total_skipped(), 0u);
 }
@@ -623,7 +623,7 @@ TEST_F(LogReaderTest, NextAfterEndKeepsReturningFalse) {
   EXPECT_TRUE(reader.Next(&record));
   EXPECT_FALSE(reader.Next(&record));
   EXPECT_FALSE(reader.Next(&record));
-  EXPECT_EQ(reader.stats().imu, 1u);
+  EXPECT_EQ(CountOf<ImuSample>(reader.stats().records), 1u);
 }
 
 TEST_F(LogReaderTest, MissingFileOrDirectoryCannotBeOpened) {
@@ -648,7 +648,7 @@ TEST(LogReaderParseLogLineTest, ClassifiesLinesWithoutTheFile) {
   EXPECT_EQ(ParseLogLine("", &record, &issue), LineParse::kBlank);
   EXPECT_EQ(ParseLogLine("  # only a comment\r", &record, &issue), LineParse::kBlank);
   ASSERT_EQ(ParseLogLine("ODOM 5 1 2\r", &record, &issue), LineParse::kRecord);
-  EXPECT_EQ(record.type, LogRecord::Type::kWheel);
+  EXPECT_TRUE(record.is<WheelRecord>());
   EXPECT_EQ(record.t(), 5.0);
   ASSERT_EQ(ParseLogLine("GNSS 6 1 2 3 4 1", &record, &issue), LineParse::kRecord);
   EXPECT_EQ(record.t(), 6.0);
@@ -670,35 +670,40 @@ TEST(LogReaderCheckLogRecordTest, SameRulesAsALine) {
     ASSERT_EQ(ParseLogLine(line, &record, &issue), LineParse::kRecord) << line;
     const LogRecord parsed = record;
     ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kRecord) << line << ": " << issue.detail;
+    ASSERT_EQ(record.type_index(), parsed.type_index());
     EXPECT_EQ(record.t(), parsed.t());
-    EXPECT_EQ(record.imu.gyro, parsed.imu.gyro);
-    EXPECT_EQ(record.gnss.heading_deg, parsed.gnss.heading_deg);
-    EXPECT_EQ(record.gnss.sigma_enu, parsed.gnss.sigma_enu);
-    EXPECT_EQ(record.gnss_velocity.v_enu, parsed.gnss_velocity.v_enu);
+    if (const ImuSample* imu = record.get_if<ImuSample>()) {
+      EXPECT_EQ(imu->gyro, parsed.get<ImuSample>().gyro);
+    }
+    if (const GnssRecord* fix = record.get_if<GnssRecord>()) {
+      EXPECT_EQ(fix->heading_deg, parsed.get<GnssRecord>().heading_deg);
+      EXPECT_EQ(fix->sigma_enu, parsed.get<GnssRecord>().sigma_enu);
+    }
+    if (const GnssVelocityRecord* velocity = record.get_if<GnssVelocityRecord>()) {
+      EXPECT_EQ(velocity->v_enu, parsed.get<GnssVelocityRecord>().v_enu);
+    }
   }
-  record = {};
-  record.type = LogRecord::Type::kGnss;
-  record.gnss = {6.0, 31.0, 120.0, 3.0, -10.0, true};
+  record = {GnssRecord{6.0, 31.0, 120.0, 3.0, -10.0, true}};
   ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kRecord);
-  EXPECT_EQ(record.gnss.heading_deg, 350.0);
-  record.gnss.sigma_enu = Vec3(0.1, 0.0, 0.1);
-  record.gnss.has_sigma = true;
+  EXPECT_EQ(record.get<GnssRecord>().heading_deg, 350.0);
+  record.get<GnssRecord>().sigma_enu = Vec3(0.1, 0.0, 0.1);
+  record.get<GnssRecord>().has_sigma = true;
   ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kDamaged);
   EXPECT_EQ(issue.reason, "absurd_value");
   EXPECT_NE(issue.detail.find("sigma_n"), std::string::npos) << issue.detail;
 
   record = {};
-  record.imu.t = 1.0;
-  record.imu.gyro.y() = std::nan("");
+  record.get<ImuSample>().t = 1.0;
+  record.get<ImuSample>().gyro.y() = std::nan("");
   ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kDamaged);
   EXPECT_EQ(issue.reason, "non_finite");
   EXPECT_NE(issue.detail.find("gy"), std::string::npos) << issue.detail;
-  record.imu.gyro.y() = 0.0;
-  record.imu.acc.z() = 1e4;
+  record.get<ImuSample>().gyro.y() = 0.0;
+  record.get<ImuSample>().acc.z() = 1e4;
   ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kDamaged);
   EXPECT_EQ(issue.reason, "absurd_value");
-  record.imu.acc.z() = 9.8;
-  record.imu.t = 0.0;
+  record.get<ImuSample>().acc.z() = 9.8;
+  record.get<ImuSample>().t = 0.0;
   ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kDamaged);
   EXPECT_EQ(issue.reason, "absurd_value");
 }
@@ -728,8 +733,8 @@ TEST_F(LogReaderTest, ImuRangeFromTheOptions) {
   wide.imu_range = {50.0, 300.0};
   const ReadResult w = ReadAll(path, wide);
   ASSERT_EQ(w.records.size(), 5u);
-  EXPECT_EQ(w.records[3].imu.acc.x(), 250.0);
-  EXPECT_EQ(w.records[4].imu.gyro.y(), 40.0);
+  EXPECT_EQ(w.records[3].get<ImuSample>().acc.x(), 250.0);
+  EXPECT_EQ(w.records[4].get<ImuSample>().gyro.y(), 40.0);
   EXPECT_EQ(w.stats.total_skipped(), 0u);
 
   LogRecord record;
@@ -740,11 +745,11 @@ TEST_F(LogReaderTest, ImuRangeFromTheOptions) {
   ASSERT_EQ(ParseLogLine("IMU 1.2 0 0 20 0 0 9.8", &record, &issue, narrow.imu_range), LineParse::kDamaged);
   EXPECT_NE(issue.detail.find("beyond ±10 (imu.max_gyro_rad_s)"), std::string::npos) << issue.detail;
   record = {};
-  record.imu.t = 1.3;
-  record.imu.acc = Vec3(250.0, 0.0, 9.8);
+  record.get<ImuSample>().t = 1.3;
+  record.get<ImuSample>().acc = Vec3(250.0, 0.0, 9.8);
   EXPECT_EQ(CheckLogRecord(&record, &issue), LineParse::kDamaged);
   EXPECT_EQ(CheckLogRecord(&record, &issue, wide.imu_range), LineParse::kRecord);
-  record.imu.acc.x() = 150.0;
+  record.get<ImuSample>().acc.x() = 150.0;
   EXPECT_EQ(CheckLogRecord(&record, &issue), LineParse::kRecord);
   EXPECT_EQ(CheckLogRecord(&record, &issue, narrow.imu_range), LineParse::kDamaged);
 }

@@ -19,7 +19,7 @@ void WriteSample(LogWriter* w) {
   s.t = 357000.0025;
   s.gyro = Vec3(0.1, -1.0 / 3.0, 2e-12);
   s.acc = Vec3(0.5, -0.25, 9.80665);
-  w->Imu(s);
+  w->Add({s});
   GnssRecord g;
   g.t = 357000.1;
   g.lat_deg = 30.4604325443;
@@ -27,12 +27,12 @@ void WriteSample(LogWriter* w) {
   g.alt_m = 23.0;
   g.has_sigma = true;
   g.sigma_enu = Vec3(0.011, 0.008, 0.036);
-  w->Gnss(g);
+  w->Add({g});
   g.t = 357000.2;
   g.has_sigma = false;
   g.heading_valid = true;
   g.heading_deg = 170.9;
-  w->Gnss(g);
+  w->Add({g});
 }
 
 TEST(LogWriterTest, RecordsReadBackExactlyPlainAndGzip) {
@@ -50,17 +50,17 @@ TEST(LogWriterTest, RecordsReadBackExactlyPlainAndGzip) {
     LogRecord rec;
     ASSERT_TRUE(r.Next(&rec));
     EXPECT_EQ(rec.line, 2u);  // the comment is one line
-    EXPECT_EQ(rec.imu.t, 357000.0025);
-    EXPECT_EQ(rec.imu.gyro, Vec3(0.1, -1.0 / 3.0, 2e-12));
-    EXPECT_EQ(rec.imu.acc, Vec3(0.5, -0.25, 9.80665));
+    EXPECT_EQ(rec.get<ImuSample>().t, 357000.0025);
+    EXPECT_EQ(rec.get<ImuSample>().gyro, Vec3(0.1, -1.0 / 3.0, 2e-12));
+    EXPECT_EQ(rec.get<ImuSample>().acc, Vec3(0.5, -0.25, 9.80665));
     ASSERT_TRUE(r.Next(&rec));
-    EXPECT_EQ(rec.gnss.lon_deg, -114.4725046685);
-    EXPECT_FALSE(rec.gnss.heading_valid);
-    EXPECT_EQ(rec.gnss.sigma_enu, Vec3(0.011, 0.008, 0.036));
+    EXPECT_EQ(rec.get<GnssRecord>().lon_deg, -114.4725046685);
+    EXPECT_FALSE(rec.get<GnssRecord>().heading_valid);
+    EXPECT_EQ(rec.get<GnssRecord>().sigma_enu, Vec3(0.011, 0.008, 0.036));
     ASSERT_TRUE(r.Next(&rec));
-    EXPECT_TRUE(rec.gnss.heading_valid);
-    EXPECT_EQ(rec.gnss.heading_deg, 170.9);
-    EXPECT_FALSE(rec.gnss.has_sigma);
+    EXPECT_TRUE(rec.get<GnssRecord>().heading_valid);
+    EXPECT_EQ(rec.get<GnssRecord>().heading_deg, 170.9);
+    EXPECT_FALSE(rec.get<GnssRecord>().has_sigma);
     EXPECT_FALSE(r.Next(&rec));
   }
   EXPECT_EQ(test::ReadFile(dir + "/log.txt").rfind("# made by a test second line\nIMU 357000.0025 0.1 ", 0), 0u);

@@ -67,10 +67,11 @@ class Nmea : public ::testing::Test {
     }
     return "no error";
   }
-  std::vector<double> Times(const Read& r, LogRecord::Type type = LogRecord::Type::kGnss) {
+  // The fixes' times.
+  std::vector<double> Times(const Read& r) {
     std::vector<double> t;
     for (const LogRecord& x : r.records) {
-      if (x.type == type) t.push_back(x.t());
+      if (x.is<GnssRecord>()) t.push_back(x.t());
     }
     return t;
   }
@@ -80,8 +81,8 @@ class Nmea : public ::testing::Test {
 TEST_F(Nmea, GgaWithRmcsDateIsAFixOnGpsTimeWithItsEllipsoidalHeight) {
   const Read r = ReadText(Rmc("173021.75") + Gga("173021.75"));
   ASSERT_EQ(r.records.size(), 2u);
-  const GnssRecord& g = r.records[0].gnss;
-  EXPECT_EQ(r.records[0].type, LogRecord::Type::kGnss);
+  const GnssRecord& g = r.records[0].get<GnssRecord>();
+  EXPECT_TRUE(r.records[0].is<GnssRecord>());
   EXPECT_EQ(r.records[0].line, 2u);
   EXPECT_EQ(g.t, kWalkGps);
   EXPECT_EQ(g.lat_deg, kLat);
@@ -90,8 +91,8 @@ TEST_F(Nmea, GgaWithRmcsDateIsAFixOnGpsTimeWithItsEllipsoidalHeight) {
   EXPECT_FALSE(g.heading_valid);
   EXPECT_EQ(g.sigma_enu, Vec3(2.0, 2.0, 4.0));  // no GST: HDOP 1.0 × single's 2 m, up 4 m
   EXPECT_EQ(r.stats.leap_seconds.at(18), 2u);
-  const GnssVelocityRecord& v = r.records[1].gnss_velocity;
-  EXPECT_EQ(r.records[1].type, LogRecord::Type::kGnssVelocity);
+  const GnssVelocityRecord& v = r.records[1].get<GnssVelocityRecord>();
+  EXPECT_TRUE(r.records[1].is<GnssVelocityRecord>());
   EXPECT_EQ(v.t, kWalkGps);
   EXPECT_EQ(v.v_enu, Vec3(0.0, 0.04 * kKnot, 0.0));
   EXPECT_EQ(v.sigma_enu, Vec3(0.1, 0.1, 0.5));
@@ -102,7 +103,7 @@ TEST_F(Nmea, GstGivesTheSigmaAndHdtTheHeading) {
   const Read r = ReadText(Gga("173021.75", "4", "0.7") + S("GNGST,173021.75,0.5,0.02,0.01,30.0,0.012,0.010,0.025") +
                           S("GNHDT,123.4,T") + Rmc("173021.75"));
   ASSERT_EQ(r.records.size(), 2u);
-  const GnssRecord& g = r.records[0].gnss;
+  const GnssRecord& g = r.records[0].get<GnssRecord>();
   EXPECT_EQ(g.sigma_enu, Vec3(0.010, 0.012, 0.025));  // GST: σ lon (east), σ lat (north), σ alt
   EXPECT_TRUE(g.heading_valid);
   EXPECT_EQ(g.heading_deg, 123.4);
@@ -117,7 +118,7 @@ TEST_F(Nmea, WithoutGstTheSigmaIsHdopTimesTheQualitysPolicy) {
                                   Vec3(2.0, 2.0, 4.0)};
   std::vector<Vec3> got;
   for (const LogRecord& x : r.records) {
-    if (x.type == LogRecord::Type::kGnss) got.push_back(x.gnss.sigma_enu);
+    if (x.is<GnssRecord>()) got.push_back(x.get<GnssRecord>().sigma_enu);
   }
   ASSERT_EQ(got.size(), 4u);
   for (size_t i = 0; i < 4; ++i) EXPECT_TRUE(got[i].isApprox(want[i], 1e-12)) << i << ": " << got[i].transpose();
@@ -131,7 +132,7 @@ TEST_F(Nmea, VtgSpeedAndCourseBecomeAGvelWithVerticalSigmaForAGrade) {
   const Read r =
       ReadText(Rmc("173021.75", "280825", "", "") + Gga("173021.75") + S("GNVTG,90.0,T,,M,19.438,N,36.000,K,A"));
   ASSERT_EQ(r.records.size(), 2u);
-  const GnssVelocityRecord& v = r.records[1].gnss_velocity;
+  const GnssVelocityRecord& v = r.records[1].get<GnssVelocityRecord>();
   EXPECT_NEAR(v.v_enu.x(), 10.0, 1e-12);  // 36 km/h east
   EXPECT_NEAR(v.v_enu.y(), 0.0, 1e-12);
   EXPECT_EQ(v.v_enu.z(), 0.0);

@@ -72,8 +72,8 @@ class RtklibPos : public ::testing::Test {
 TEST_F(RtklibPos, ReadsGpstCalendarLinesAsGnssRecordsWithSigmaEastNorthUp) {
   const Read r = ReadText(std::string(kLlhHeader) + kGpstColumns + Line(0) + Line(1));
   ASSERT_EQ(r.records.size(), 2u);
-  const GnssRecord& g = r.records[0].gnss;
-  EXPECT_EQ(r.records[0].type, LogRecord::Type::kGnss);
+  const GnssRecord& g = r.records[0].get<GnssRecord>();
+  EXPECT_TRUE(r.records[0].is<GnssRecord>());
   EXPECT_EQ(r.records[0].line, 4u);
   EXPECT_EQ(g.t, kWalkGps);
   EXPECT_EQ(g.lat_deg, 40.096716094);
@@ -82,7 +82,7 @@ TEST_F(RtklibPos, ReadsGpstCalendarLinesAsGnssRecordsWithSigmaEastNorthUp) {
   EXPECT_FALSE(g.heading_valid);
   ASSERT_TRUE(g.has_sigma);
   EXPECT_EQ(g.sigma_enu, Vec3(1.7674, 2.0453, 4.7139));  // sde, sdn, sdu
-  EXPECT_EQ(r.records[1].gnss.t, kWalkGps + 1.0);
+  EXPECT_EQ(r.records[1].get<GnssRecord>().t, kWalkGps + 1.0);
   EXPECT_EQ(r.stats.qualities.at("single"), 2u);
   EXPECT_EQ(r.stats.leap_seconds.at(0), 2u);
   EXPECT_EQ(r.file.total_skipped(), 0u);
@@ -93,12 +93,12 @@ TEST_F(RtklibPos, ReadsUtcCalendarTimesIntoGpsSeconds) {
   columns.replace(columns.find("GPST"), 4, "UTC ");
   const Read r = ReadText(std::string(kLlhHeader) + columns + Line(0, 5, "2025/08/28 17:30:21.750"));
   ASSERT_EQ(r.records.size(), 1u);
-  EXPECT_EQ(r.records[0].gnss.t, kWalkGps);
+  EXPECT_EQ(r.records[0].get<GnssRecord>().t, kWalkGps);
   EXPECT_EQ(r.stats.leap_seconds.at(18), 1u);
   GnssFormatOptions unix_log;
   unix_log.time_scale = LogTimeScale::kUnixUtc;
   const Read u = ReadText(std::string(kLlhHeader) + columns + Line(0, 5, "2025/08/28 17:30:21.750"), {}, unix_log);
-  EXPECT_EQ(u.records[0].gnss.t, kWalkGps + kGpsEpochUnix - 18.0);
+  EXPECT_EQ(u.records[0].get<GnssRecord>().t, kWalkGps + kGpsEpochUnix - 18.0);
 }
 
 TEST_F(RtklibPos, ReadsWeekSecondsTimesWithCommaSeparatedFields) {
@@ -110,8 +110,8 @@ TEST_F(RtklibPos, ReadsWeekSecondsTimesWithCommaSeparatedFields) {
                "2381,408621.750,  40.096716094,-105.147133192, 1584.3679,  1, 15,  0.0100,  0.0120,  "
                "0.0300, -0.0010, -0.0010, -0.0010,  0.00,   0.0\n");
   ASSERT_EQ(r.records.size(), 1u);
-  EXPECT_EQ(r.records[0].gnss.t, kWalkGps);
-  EXPECT_EQ(r.records[0].gnss.sigma_enu, Vec3(0.012, 0.01, 0.03));
+  EXPECT_EQ(r.records[0].get<GnssRecord>().t, kWalkGps);
+  EXPECT_EQ(r.records[0].get<GnssRecord>().sigma_enu, Vec3(0.012, 0.01, 0.03));
   EXPECT_EQ(r.stats.qualities.at("fix"), 1u);
 }
 
@@ -120,7 +120,7 @@ TEST_F(RtklibPos, JstTimesAreUtcPlusNineHours) {
   columns.replace(columns.find("GPST"), 4, "JST ");
   const Read r = ReadText(std::string(kLlhHeader) + columns + Line(0, 5, "2025/08/29 02:30:21.750"));
   ASSERT_EQ(r.records.size(), 1u);
-  EXPECT_EQ(r.records[0].gnss.t, kWalkGps);
+  EXPECT_EQ(r.records[0].get<GnssRecord>().t, kWalkGps);
 }
 
 TEST_F(RtklibPos, RotatesEcefSigmaIntoEnuAtThePoint) {
@@ -144,9 +144,10 @@ TEST_F(RtklibPos, RotatesEcefSigmaIntoEnuAtThePoint) {
       "sdxy(m)  sdyz(m)  sdzx(m) age(s)  ratio    vx(m/s)    vy(m/s)    vz(m/s)\n" +
       std::string(line));
   ASSERT_EQ(r.records.size(), 2u);
-  EXPECT_TRUE(r.records[1].gnss_velocity.v_enu.isApprox(Vec3(1.0, 2.0, 0.5), 1e-8)) << r.records[1].gnss_velocity.v_enu.transpose();
-  EXPECT_FALSE(r.records[1].gnss_velocity.has_sigma);
-  const GnssRecord& g = r.records[0].gnss;
+  const GnssVelocityRecord& velocity = r.records[1].get<GnssVelocityRecord>();
+  EXPECT_TRUE(velocity.v_enu.isApprox(Vec3(1.0, 2.0, 0.5), 1e-8)) << velocity.v_enu.transpose();
+  EXPECT_FALSE(velocity.has_sigma);
+  const GnssRecord& g = r.records[0].get<GnssRecord>();
   EXPECT_NEAR(g.lat_deg, lat, 1e-10);
   EXPECT_NEAR(g.lon_deg, lon, 1e-10);
   EXPECT_NEAR(g.alt_m, h, 1e-4);
@@ -165,11 +166,11 @@ TEST_F(RtklibPos, ReadsDegreesMinutesSecondsPositions) {
       "2025/08/28 17:30:40.750   -0 30 00.00000 -0 15 00.00000  1584.3679   5  15   2.0453   1.7674   4.7139  "
       "-0.6069  -0.5974  -1.3199   0.00    0.0\n");
   ASSERT_EQ(r.records.size(), 2u);
-  EXPECT_NEAR(r.records[0].gnss.lat_deg, 40.096716094, 1e-9);
-  EXPECT_NEAR(r.records[0].gnss.lon_deg, -105.147133192, 1e-9);
-  EXPECT_EQ(r.records[1].gnss.lat_deg, -0.5);  // the sign of "-0" kept
-  EXPECT_EQ(r.records[1].gnss.lon_deg, -0.25);
-  EXPECT_EQ(r.records[0].gnss.sigma_enu, Vec3(1.7674, 2.0453, 4.7139));
+  EXPECT_NEAR(r.records[0].get<GnssRecord>().lat_deg, 40.096716094, 1e-9);
+  EXPECT_NEAR(r.records[0].get<GnssRecord>().lon_deg, -105.147133192, 1e-9);
+  EXPECT_EQ(r.records[1].get<GnssRecord>().lat_deg, -0.5);  // the sign of "-0" kept
+  EXPECT_EQ(r.records[1].get<GnssRecord>().lon_deg, -0.25);
+  EXPECT_EQ(r.records[0].get<GnssRecord>().sigma_enu, Vec3(1.7674, 2.0453, 4.7139));
 }
 
 TEST_F(RtklibPos, VelocityColumnsBecomeGvelRecordsAfterTheirFix) {
@@ -179,13 +180,13 @@ TEST_F(RtklibPos, VelocityColumnsBecomeGvelRecordsAfterTheirFix) {
                Line(0).substr(0, Line(0).size() - 1) +
                "   -0.01042    0.01309    0.01111   0.11605  0.09911  0.26458  0.01401 -0.03757 -0.07552\n");
   ASSERT_EQ(r.records.size(), 2u);
-  EXPECT_EQ(r.records[1].type, LogRecord::Type::kGnssVelocity);
-  const GnssVelocityRecord& v = r.records[1].gnss_velocity;
+  EXPECT_TRUE(r.records[1].is<GnssVelocityRecord>());
+  const GnssVelocityRecord& v = r.records[1].get<GnssVelocityRecord>();
   EXPECT_EQ(v.t, kWalkGps);
   EXPECT_EQ(v.v_enu, Vec3(0.01309, -0.01042, 0.01111));
   ASSERT_TRUE(v.has_sigma);
   EXPECT_EQ(v.sigma_enu, Vec3(0.09911, 0.11605, 0.26458));
-  EXPECT_EQ(r.stats.records[static_cast<int>(LogRecord::Type::kGnssVelocity)], 1u);
+  EXPECT_EQ(CountOf<GnssVelocityRecord>(r.stats.records), 1u);
 }
 
 TEST_F(RtklibPos, KeepsEveryQualityWithItsSigmaAndDropsWhatIsBelowMinQuality) {
@@ -195,13 +196,13 @@ TEST_F(RtklibPos, KeepsEveryQualityWithItsSigmaAndDropsWhatIsBelowMinQuality) {
   ASSERT_EQ(all.records.size(), 6u);  // Q 7, the solver's dead reckoning, is not a measurement
   EXPECT_EQ(all.stats.dropped.at("dead reckoning (Q 7)"), 1u);
   for (const char* q : {"fix", "float", "sbas", "dgps", "single", "ppp"}) EXPECT_EQ(all.stats.qualities.at(q), 1u) << q;
-  for (const LogRecord& r : all.records) EXPECT_EQ(r.gnss.sigma_enu, Vec3(1.7674, 2.0453, 4.7139));
+  for (const LogRecord& r : all.records) EXPECT_EQ(r.get<GnssRecord>().sigma_enu, Vec3(1.7674, 2.0453, 4.7139));
   GnssFormatOptions floats;
   floats.min_quality = FixQuality::kFloat;
   const Read best = ReadText(text, {}, floats);
   ASSERT_EQ(best.records.size(), 2u);  // Q 1 and 2
-  EXPECT_EQ(best.records[0].gnss.t, kWalkGps + 1.0);
-  EXPECT_EQ(best.records[1].gnss.t, kWalkGps + 2.0);
+  EXPECT_EQ(best.records[0].get<GnssRecord>().t, kWalkGps + 1.0);
+  EXPECT_EQ(best.records[1].get<GnssRecord>().t, kWalkGps + 2.0);
   EXPECT_EQ(best.stats.dropped.at("Q single (below --min-quality float)"), 1u);
   EXPECT_EQ(best.stats.dropped.at("Q ppp (below --min-quality float)"), 1u);
   EXPECT_EQ(best.file.total_skipped(), 0u);
@@ -264,8 +265,8 @@ TEST_F(RtklibPos, RefusesHeightsAboveTheGeoidAndBaselines) {
 TEST_F(RtklibPos, WithoutAHeaderTakesRtklibsDefaultColumnsAndSaysSo) {
   const Read r = ReadText(Line(0) + Line(1));
   ASSERT_EQ(r.records.size(), 2u);
-  EXPECT_EQ(r.records[0].gnss.lat_deg, 40.096716094);
-  EXPECT_EQ(r.records[0].gnss.sigma_enu, Vec3(1.7674, 2.0453, 4.7139));
+  EXPECT_EQ(r.records[0].get<GnssRecord>().lat_deg, 40.096716094);
+  EXPECT_EQ(r.records[0].get<GnssRecord>().sigma_enu, Vec3(1.7674, 2.0453, 4.7139));
   EXPECT_EQ(r.file.warnings.at("no_header"), 1u);
 }
 

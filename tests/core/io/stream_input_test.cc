@@ -61,7 +61,7 @@ TEST(StreamInputTest, HandsOnEachLineAsItArrives) {
   data.CloseWrite();
   EXPECT_FALSE(reader.Next(&record));
   EXPECT_FALSE(reader.stopped());
-  EXPECT_EQ(reader.stats().imu, 2u);
+  EXPECT_EQ(CountOf<ImuSample>(reader.stats().records), 2u);
   EXPECT_EQ(reader.stats().total_skipped(), 1u);
 }
 

@@ -48,9 +48,10 @@ inline std::vector<SimRecord> RunAll(const SimOptions& options) {
   return out;
 }
 
-inline std::vector<SimRecord> OfType(const std::vector<SimRecord>& all, SimRecord::Type type) {
+template <typename R>
+std::vector<SimRecord> OfType(const std::vector<SimRecord>& all) {
   std::vector<SimRecord> out;
-  std::copy_if(all.begin(), all.end(), std::back_inserter(out), [&](const SimRecord& r) { return r.type == type; });
+  std::copy_if(all.begin(), all.end(), std::back_inserter(out), [](const SimRecord& r) { return r.is<R>(); });
   return out;
 }
 

@@ -39,20 +39,20 @@ TEST(SimEarth, AtRestImuReadsEarthRateAndLocalGravity) {
   int at_origin = 0, far = 0;
   SimRecord r;
   while (sim.Next(&r)) {
-    if (r.type != SimRecord::Type::kImu) continue;
-    const double s = r.imu.t - options.start_time;
+    if (!r.is<ImuSample>()) continue;
+    const double s = r.get<ImuSample>().t - options.start_time;
     const bool parked = (s > 1.0 && s < 9.0) || (s > 471.0 && s < 483.0);  // FarDrive's standstills
     if (!parked) continue;
     const NavState& x = r.truth;
     ASSERT_LT(x.v_w.norm(), 1e-12) << s;
-    EXPECT_LT((x.q_wb * r.imu.gyro - earth_rate_w).norm(), 1e-18) << s;
-    EXPECT_NEAR(r.imu.gyro.norm(), kEarthRate, 1e-18) << s;
+    EXPECT_LT((x.q_wb * r.get<ImuSample>().gyro - earth_rate_w).norm(), 1e-18) << s;
+    EXPECT_NEAR(r.get<ImuSample>().gyro.norm(), kEarthRate, 1e-18) << s;
     const GeodeticPoint g = frame.ToGeodetic(x.p_wb);
     const Vec3 g_w = NormalGravityWorld(frame, x.p_wb);
-    EXPECT_LT((r.imu.acc + x.q_wb.conjugate() * g_w).norm(), 1e-14) << s;
-    EXPECT_NEAR(r.imu.acc.norm(), NormalGravity(g.lat_deg, g.alt_m), 1e-12) << s;
+    EXPECT_LT((r.get<ImuSample>().acc + x.q_wb.conjugate() * g_w).norm(), 1e-14) << s;
+    EXPECT_NEAR(r.get<ImuSample>().acc.norm(), NormalGravity(g.lat_deg, g.alt_m), 1e-12) << s;
     // The plumb line leans from w's vertical by the distance over the Earth's radius.
-    const Vec3 up_w = (x.q_wb * r.imu.acc).normalized();
+    const Vec3 up_w = (x.q_wb * r.get<ImuSample>().acc).normalized();
     const double lean = std::acos(std::min(1.0, up_w.z()));
     const double d = x.p_wb.head<2>().norm();
     if (d < 1.0) {
@@ -90,8 +90,9 @@ KernelRun IntegrateWithKernel(double imu_rate, bool with_earth_rate) {
   run.v.push_back(k.v);
   const int keep_every = static_cast<int>(imu_rate / 100.0);
   for (int i = 1; sim.Next(&r); ++i) {
-    const ImuSample held = HeldBetween(prev.imu, r.imu);
-    k = ImuStep(k, held.gyro, held.acc, earth.Gravity(k.p), r.imu.t - prev.imu.t, nullptr, earth_rate_w);
+    const ImuSample &a = prev.get<ImuSample>(), &b = r.get<ImuSample>();
+    const ImuSample held = HeldBetween(a, b);
+    k = ImuStep(k, held.gyro, held.acc, earth.Gravity(k.p), b.t - a.t, nullptr, earth_rate_w);
     const NavState& x = r.truth;  // exact at the sample (record times carry unix-time round-off)
     run.max_p = std::max(run.max_p, (k.p - x.p_wb).norm());
     run.max_v = std::max(run.max_v, (k.v - x.v_w).norm());
@@ -150,7 +151,7 @@ TEST(SimEarth, TruthFileReadsBackIntoWorld) {
   Simulate(options, dir);
   const LocalEnuFrame frame(options.origin);
   const std::vector<TruthSample> rows = ReadTruth(dir + "/truth.csv", frame);
-  const std::vector<SimRecord> imu = OfType(RunAll(options), SimRecord::Type::kImu);
+  const std::vector<SimRecord> imu = OfType<ImuSample>(RunAll(options));
   ASSERT_EQ(rows.size(), imu.size());
   ASSERT_EQ(rows.size(), 6001u);
   double max_att = 0.0, max_v = 0.0, max_p = 0.0, max_turn = 0.0;
@@ -182,17 +183,18 @@ TEST(SimEarth, HeadingFromTrueNorthAtTheAntenna) {
   const GeographicLib::Geodesic& geodesic = GeographicLib::Geodesic::WGS84();
   double max_err = 0.0, max_convergence = 0.0;
   int fixes = 0;
-  for (const SimRecord& r : OfType(RunAll(options), SimRecord::Type::kGnss)) {
-    ASSERT_TRUE(r.gnss.heading_valid);
+  for (const SimRecord& r : OfType<GnssRecord>(RunAll(options))) {
+    const GnssRecord& fix = r.get<GnssRecord>();
+    ASSERT_TRUE(fix.heading_valid);
     const NavState& x = r.truth;
     const Vec3 p_ant_w = x.p_wb + x.q_wb * options.lever_b;
     const Vec3 x_G_w = x.q_wb * Vec3(std::cos(options.mount_yaw), std::sin(options.mount_yaw), 0.0);
     const GeodeticPoint a = frame.ToGeodetic(p_ant_w), b = frame.ToGeodetic(p_ant_w + x_G_w);
     double azi1 = 0.0, azi2 = 0.0;
     geodesic.Inverse(a.lat_deg, a.lon_deg, b.lat_deg, b.lon_deg, azi1, azi2);
-    max_err = std::max(max_err, std::abs(WrapAngle((r.gnss.heading_deg - azi1) * kDegToRad)));
+    max_err = std::max(max_err, std::abs(WrapAngle((fix.heading_deg - azi1) * kDegToRad)));
     const double heading_w = EnuYawToCompassDeg(std::atan2(x_G_w.y(), x_G_w.x()));
-    max_convergence = std::max(max_convergence, std::abs(WrapAngle((r.gnss.heading_deg - heading_w) * kDegToRad)));
+    max_convergence = std::max(max_convergence, std::abs(WrapAngle((fix.heading_deg - heading_w) * kDegToRad)));
     ++fixes;
   }
   EXPECT_EQ(fixes, 601);

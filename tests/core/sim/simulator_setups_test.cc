@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "config/config_loader.h"
@@ -23,7 +24,6 @@ using test::FarDrive;
 using test::NoiseFreeSim;
 using test::OfType;
 using test::RunAll;
-using Type = SimRecord::Type;
 
 // 60 s (simulator_test.cc's drive): standstill, accelerate, climbing left turn, level right turn,
 // descending left turn while braking, accelerate, brake to a stop at ~57 s.
@@ -40,18 +40,28 @@ SimOptions Drive() {
 
 bool SameImu(const ImuSample& a, const ImuSample& b) { return a.t == b.t && a.gyro == b.gyro && a.acc == b.acc; }
 
+bool SameFields(const ImuSample& a, const ImuSample& b) { return SameImu(a, b); }
+bool SameFields(const WheelRecord& a, const WheelRecord& b) {
+  return a.left_pulses == b.left_pulses && a.right_pulses == b.right_pulses;
+}
+bool SameFields(const GnssRecord& a, const GnssRecord& b) {
+  return a.lat_deg == b.lat_deg && a.lon_deg == b.lon_deg && a.alt_m == b.alt_m && a.heading_deg == b.heading_deg &&
+         a.heading_valid == b.heading_valid;
+}
+bool SameFields(const GnssVelocityRecord& a, const GnssVelocityRecord& b) { return a.v_enu == b.v_enu; }
+
 // Bit for bit, whatever the type.
 bool SameRecord(const SimRecord& a, const SimRecord& b) {
-  return a.type == b.type && a.t() == b.t() && SameImu(a.imu, b.imu) && a.wheel.left_pulses == b.wheel.left_pulses &&
-         a.wheel.right_pulses == b.wheel.right_pulses && a.gnss.lat_deg == b.gnss.lat_deg &&
-         a.gnss.lon_deg == b.gnss.lon_deg && a.gnss.alt_m == b.gnss.alt_m && a.gnss.heading_deg == b.gnss.heading_deg &&
-         a.gnss.heading_valid == b.gnss.heading_valid && a.gnss_velocity.v_enu == b.gnss_velocity.v_enu;
+  return a.type_index() == b.type_index() && a.t() == b.t() && std::visit([&b](const auto& m) {
+           return SameFields(m, std::get<std::decay_t<decltype(m)>>(b.data));
+         }, a.data);
 }
 
-std::vector<SimRecord> Without(const std::vector<SimRecord>& all, Type type) {
+template <typename R>
+std::vector<SimRecord> Without(const std::vector<SimRecord>& all) {
   std::vector<SimRecord> out;
   for (const SimRecord& r : all) {
-    if (r.type != type) out.push_back(r);
+    if (!r.is<R>()) out.push_back(r);
   }
   return out;
 }
@@ -90,17 +100,17 @@ TEST(SimGvel, EveryFixHasAVelocityRecordRightAfterIt) {
   const std::vector<SimRecord> all = RunAll(options);
   size_t gnss = 0, gnss_velocity = 0;
   for (size_t i = 0; i < all.size(); ++i) {
-    if (all[i].type == Type::kGnss) {
+    if (all[i].is<GnssRecord>()) {
       ++gnss;
       ASSERT_LT(i + 1, all.size());
-      EXPECT_EQ(all[i + 1].type, Type::kGnssVelocity) << all[i].t();
+      EXPECT_TRUE(all[i + 1].is<GnssVelocityRecord>()) << all[i].t();
       EXPECT_EQ(all[i + 1].t(), all[i].t());
-    } else if (all[i].type == Type::kGnssVelocity) {
+    } else if (all[i].is<GnssVelocityRecord>()) {
       ++gnss_velocity;
       ASSERT_GT(i, 0u);
-      EXPECT_EQ(all[i - 1].type, Type::kGnss);
-      EXPECT_TRUE(all[i].gnss_velocity.has_sigma);
-      EXPECT_EQ(all[i].gnss_velocity.sigma_enu, options.gnss_velocity_sigma);
+      EXPECT_TRUE(all[i - 1].is<GnssRecord>());
+      EXPECT_TRUE(all[i].get<GnssVelocityRecord>().has_sigma);
+      EXPECT_EQ(all[i].get<GnssVelocityRecord>().sigma_enu, options.gnss_velocity_sigma);
       const double s = all[i].t() - options.start_time;
       EXPECT_FALSE(s > 10.0 - 1e-4 && s < 15.0 - 1e-4) << s;  // the outage holds for GVEL too
     }
@@ -111,8 +121,8 @@ TEST(SimGvel, EveryFixHasAVelocityRecordRightAfterIt) {
   // σ = 0: no GVEL, and every other record unchanged (GVEL draws from its own stream).
   options.gnss_velocity_sigma.setZero();
   const std::vector<SimRecord> none = RunAll(options);
-  EXPECT_TRUE(OfType(none, Type::kGnssVelocity).empty());
-  const std::vector<SimRecord> rest = Without(all, Type::kGnssVelocity);
+  EXPECT_TRUE(OfType<GnssVelocityRecord>(none).empty());
+  const std::vector<SimRecord> rest = Without<GnssVelocityRecord>(all);
   ASSERT_EQ(rest.size(), none.size());
   for (size_t i = 0; i < rest.size(); ++i) ASSERT_TRUE(SameRecord(rest[i], none[i])) << i;
 }
@@ -135,15 +145,15 @@ TEST(SimGvel, NoiseFreeRecordsAreTheAntennaVelocity) {
     int checked = 0;
     SimRecord r;
     while (sim.Next(&r)) {
-      if (r.type != Type::kGnssVelocity) continue;
-      const double s = r.gnss_velocity.t - options.start_time;
+      if (!r.is<GnssVelocityRecord>()) continue;
+      const double s = r.get<GnssVelocityRecord>().t - options.start_time;
       if (s < 1e-3 || s > sim.truth().duration() - 1e-3) continue;  // differences need both sides
       const Vec3 v_ant_w = AntennaVelocityW(sim.truth(), s, options.lever_b);
       const TruthState x = sim.truth().AtElapsed(s);
       const Vec3 p_ant_w = x.p_wb + x.q_wb * options.lever_b;
       const Mat3 R_w_l = rotating ? frame.RotationFromLocalEnu(frame.ToGeodetic(p_ant_w)) : Mat3::Identity();
-      max_err = std::max(max_err, (r.gnss_velocity.v_enu - R_w_l.transpose() * v_ant_w).norm());
-      max_rotation_effect = std::max(max_rotation_effect, (r.gnss_velocity.v_enu - v_ant_w).norm());
+      max_err = std::max(max_err, (r.get<GnssVelocityRecord>().v_enu - R_w_l.transpose() * v_ant_w).norm());
+      max_rotation_effect = std::max(max_rotation_effect, (r.get<GnssVelocityRecord>().v_enu - v_ant_w).norm());
       ++checked;
     }
     EXPECT_GT(checked, 290);
@@ -165,10 +175,10 @@ TEST(SimGvel, NoiseMatchesSigma) {
   int n = 0;
   SimRecord r;
   while (sim.Next(&r)) {
-    if (r.type != Type::kGnssVelocity) continue;
+    if (!r.is<GnssVelocityRecord>()) continue;
     const TruthState x = sim.truth().AtElapsed(static_cast<double>(n) / options.gnss_rate);
     const Vec3 v_ant_w = x.v_w + x.q_wb * x.omega_b.cross(options.lever_b);
-    sum_sq += (r.gnss_velocity.v_enu - v_ant_w).cwiseAbs2();
+    sum_sq += (r.get<GnssVelocityRecord>().v_enu - v_ant_w).cwiseAbs2();
     ++n;
   }
   ASSERT_EQ(n, 1201);
@@ -183,11 +193,11 @@ TEST(SimGvel, WrittenAfterItsFixWithSigmaColumns) {
   options.gnss_velocity_sigma = Vec3(0.05, 0.05, 0.1);
   const std::string dir = test::MakeTempDir("sim_gvel");
   const SimulationResult result = Simulate(options, dir);
-  EXPECT_EQ(result.gnss_velocity, 37u);
-  EXPECT_EQ(result.gnss, 37u);
+  EXPECT_EQ(CountOf<GnssVelocityRecord>(result.records), 37u);
+  EXPECT_EQ(CountOf<GnssRecord>(result.records), 37u);
   const std::vector<std::string> log = Lines(test::ReadFile(dir + "/log.txt"));
   EXPECT_NE(log.at(1).find("| GVEL t ve vn vu se sn su"), std::string::npos) << log[1];
-  const std::vector<SimRecord> gnss_velocity = OfType(RunAll(options), Type::kGnssVelocity);
+  const std::vector<SimRecord> gnss_velocity = OfType<GnssVelocityRecord>(RunAll(options));
   size_t n = 0;
   for (size_t i = 0; i < log.size(); ++i) {
     const std::vector<std::string> f = Fields(log[i]);
@@ -195,7 +205,7 @@ TEST(SimGvel, WrittenAfterItsFixWithSigmaColumns) {
     ASSERT_EQ(f.size(), 8u) << log[i];
     EXPECT_EQ(Fields(log[i - 1]).at(0), "GNSS");
     EXPECT_EQ(Fields(log[i - 1]).at(1), f[1]);
-    const GnssVelocityRecord& g = gnss_velocity.at(n++).gnss_velocity;
+    const GnssVelocityRecord& g = gnss_velocity.at(n++).get<GnssVelocityRecord>();
     EXPECT_NEAR(std::stod(f[1]), g.t, 1e-6);
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(std::stod(f[2 + k]), g.v_enu[k], 5.001e-5);
@@ -247,20 +257,21 @@ TEST(SimReverse, BacksUpFacingForwardWithoutSideSlip) {
 
 TEST(SimReverse, WheelPulsesAreNegativeWhenBackingUp) {
   const SimOptions options = ReverseDrive();
-  const std::vector<SimRecord> wheel = OfType(RunAll(options), Type::kWheel);
+  const std::vector<SimRecord> wheel = OfType<WheelRecord>(RunAll(options));
   const TruthTrajectory truth(options);
   const double dt = 1.0 / options.wheel_rate;
   const double pulse_speed = WheelSpeedFromPulses(1.0, options.wheel_radius, options.pulses_per_rev, dt);
   int negative = 0;
   for (const SimRecord& r : wheel) {
-    const double s1 = r.wheel.t - options.start_time;
+    const WheelRecord& wheel_record = r.get<WheelRecord>();
+    const double s1 = wheel_record.t - options.start_time;
     const Vec2 mean = truth.IntegrateSpeedAndYawRate(s1 - dt, s1) / dt;  // signed
-    const double left = WheelSpeedFromPulses(r.wheel.left_pulses, options.wheel_radius, options.pulses_per_rev, dt);
-    const double right = WheelSpeedFromPulses(r.wheel.right_pulses, options.wheel_radius, options.pulses_per_rev, dt);
+    const double left = WheelSpeedFromPulses(wheel_record.left_pulses, options.wheel_radius, options.pulses_per_rev, dt);
+    const double right = WheelSpeedFromPulses(wheel_record.right_pulses, options.wheel_radius, options.pulses_per_rev, dt);
     EXPECT_NEAR(0.5 * (left + right) / options.wheel_scale, mean.x(), pulse_speed / options.wheel_scale + 1e-9);
     if (truth.AtElapsed(s1).reverse && mean.x() < -0.5) {
-      EXPECT_LT(r.wheel.left_pulses, 0.0) << s1;
-      EXPECT_LT(r.wheel.right_pulses, 0.0) << s1;
+      EXPECT_LT(wheel_record.left_pulses, 0.0) << s1;
+      EXPECT_LT(wheel_record.right_pulses, 0.0) << s1;
       ++negative;
     }
   }
@@ -335,19 +346,19 @@ TEST(SimLogStart, RecordsStartAtTheCutAndAreThoseOfTheWholeDrive) {
   const std::vector<SimRecord> cut = RunAll(options);
   const double t_cut = options.start_time + 12.34;
   ASSERT_FALSE(cut.empty());
-  EXPECT_EQ(cut.front().type, Type::kImu);
+  EXPECT_TRUE(cut.front().is<ImuSample>());
   EXPECT_NEAR(cut.front().t(), t_cut, 1e-6);
   EXPECT_GT(cut.front().truth.v_w.norm(), 5.0);  // driving
-  EXPECT_NEAR(OfType(cut, Type::kGnss).front().t(), options.start_time + 12.4, 1e-6);
-  EXPECT_NEAR(OfType(cut, Type::kGnssVelocity).front().t(), options.start_time + 12.4, 1e-6);
+  EXPECT_NEAR(OfType<GnssRecord>(cut).front().t(), options.start_time + 12.4, 1e-6);
+  EXPECT_NEAR(OfType<GnssVelocityRecord>(cut).front().t(), options.start_time + 12.4, 1e-6);
   // Pulses over (12.3, 12.4] straddle the cut: the first encoder record counts over (12.4, 12.5].
-  EXPECT_NEAR(OfType(cut, Type::kWheel).front().t(), options.start_time + 12.5, 1e-6);
+  EXPECT_NEAR(OfType<WheelRecord>(cut).front().t(), options.start_time + 12.5, 1e-6);
 
   // The same records, bit for bit, as the whole drive's from the cut on (bias walks, pulse remainders and
   // the correlated GNSS error all ran before it).
   std::vector<SimRecord> expected;
   for (const SimRecord& r : whole) {
-    const bool odom_straddles = r.type == Type::kWheel && r.t() < t_cut + 0.1 - 1e-6;
+    const bool odom_straddles = r.is<WheelRecord>() && r.t() < t_cut + 0.1 - 1e-6;
     if (r.t() >= t_cut - 1e-6 && !odom_straddles) expected.push_back(r);
   }
   ASSERT_EQ(cut.size(), expected.size());
@@ -361,13 +372,13 @@ TEST(SimLogStart, RecordsStartAtTheCutAndAreThoseOfTheWholeDrive) {
   options.segments.resize(4);  // 26 s
   const std::string dir = test::MakeTempDir("sim_log_start");
   const SimulationResult result = Simulate(options, dir);
-  EXPECT_EQ(result.imu, 2600u - 1234u + 1u);
+  EXPECT_EQ(CountOf<ImuSample>(result.records), 2600u - 1234u + 1u);
   EXPECT_DOUBLE_EQ(result.duration, 26.0);
   const std::vector<std::string> log = Lines(test::ReadFile(dir + "/log.txt"));
   EXPECT_NE(log.at(0).find(" log_start=12.34"), std::string::npos) << log[0];
   EXPECT_EQ(log.at(2).rfind("IMU 1700000012.340000 ", 0), 0u) << log[2];
   const std::vector<std::string> truth = Lines(test::ReadFile(dir + "/truth.csv"));
-  EXPECT_EQ(truth.size(), 1u + result.imu);
+  EXPECT_EQ(truth.size(), 1u + CountOf<ImuSample>(result.records));
   EXPECT_EQ(truth.at(1).rfind("1700000012.340000,", 0), 0u) << truth[1];
 }
 
@@ -378,7 +389,7 @@ TEST(SimLogStart, MustBeWithinTheDrive) {
   options.log_start = -1.0;
   EXPECT_NE(InvalidArgument(options).find("log_start"), std::string::npos);
   options.log_start = 59.99;
-  EXPECT_EQ(OfType(RunAll(options), Type::kImu).size(), 2u);
+  EXPECT_EQ(OfType<ImuSample>(RunAll(options)).size(), 2u);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -388,9 +399,10 @@ TEST(SimLogStart, MustBeWithinTheDrive) {
 std::vector<Vec3> GnssErrors(const SimOptions& options) {
   const LocalEnuFrame frame(options.origin);
   std::vector<Vec3> e;
-  for (const SimRecord& r : OfType(RunAll(options), Type::kGnss)) {
+  for (const SimRecord& r : OfType<GnssRecord>(RunAll(options))) {
+    const GnssRecord& fix = r.get<GnssRecord>();
     const NavState& x = r.truth;
-    e.push_back(frame.ToEnu({r.gnss.lat_deg, r.gnss.lon_deg, r.gnss.alt_m}) - (x.p_wb + x.q_wb * options.lever_b));
+    e.push_back(frame.ToEnu({fix.lat_deg, fix.lon_deg, fix.alt_m}) - (x.p_wb + x.q_wb * options.lever_b));
   }
   return e;
 }
@@ -447,8 +459,8 @@ TEST(SimGnssCorrelation, MadeOfTheWhiteNoiseDraws) {
   const std::vector<SimRecord> a = RunAll(white), b = RunAll(correlated);
   ASSERT_EQ(a.size(), b.size());
   for (size_t i = 0; i < a.size(); ++i) {
-    if (a[i].type == Type::kGnss) {
-      EXPECT_EQ(a[i].gnss.heading_deg, b[i].gnss.heading_deg);
+    if (a[i].is<GnssRecord>()) {
+      EXPECT_EQ(a[i].get<GnssRecord>().heading_deg, b[i].get<GnssRecord>().heading_deg);
     } else {
       ASSERT_TRUE(SameRecord(a[i], b[i])) << i;
     }

@@ -57,9 +57,10 @@ std::vector<SimRecord> RunAll(const SimOptions& options) {
   return out;
 }
 
-std::vector<SimRecord> OfType(const std::vector<SimRecord>& all, SimRecord::Type type) {
+template <typename R>
+std::vector<SimRecord> OfType(const std::vector<SimRecord>& all) {
   std::vector<SimRecord> out;
-  std::copy_if(all.begin(), all.end(), std::back_inserter(out), [&](const SimRecord& r) { return r.type == type; });
+  std::copy_if(all.begin(), all.end(), std::back_inserter(out), [](const SimRecord& r) { return r.is<R>(); });
   return out;
 }
 
@@ -213,7 +214,8 @@ KernelRun IntegrateWithKernel(double imu_rate) {
   run.v.push_back(k.v);
   const int keep_every = static_cast<int>(imu_rate / 100.0);
   for (int i = 1; sim.Next(&r); ++i) {
-    k = ImuStep(k, prev.imu.gyro, prev.imu.acc, sim.truth().gravity_w(), r.imu.t - prev.imu.t);
+    const ImuSample &a = prev.get<ImuSample>(), &b = r.get<ImuSample>();
+    k = ImuStep(k, a.gyro, a.acc, sim.truth().gravity_w(), b.t - a.t);
     const NavState& x = r.truth;  // exact at the sample (record times carry unix-time round-off)
     run.max_p = std::max(run.max_p, (k.p - x.p_wb).norm());
     run.max_v = std::max(run.max_v, (k.v - x.v_w).norm());
@@ -275,9 +277,9 @@ TEST(SimImu, NoiseAndBiasStatistics) {
   Vec3 bg0 = Vec3::Zero();
   Vec3 bg_last = Vec3::Zero();
   while (sim.Next(&r)) {
-    const TruthState x = sim.truth().At(r.imu.t);
-    const Vec3 eg = r.imu.gyro - x.omega_b - r.truth.bg;
-    const Vec3 ea = r.imu.acc - x.q_wb.conjugate() * (x.a_w - sim.truth().gravity_w()) - r.truth.ba;
+    const TruthState x = sim.truth().At(r.get<ImuSample>().t);
+    const Vec3 eg = r.get<ImuSample>().gyro - x.omega_b - r.truth.bg;
+    const Vec3 ea = r.get<ImuSample>().acc - x.q_wb.conjugate() * (x.a_w - sim.truth().gravity_w()) - r.truth.ba;
     sg += eg.squaredNorm();
     sa += ea.squaredNorm();
     if (n == 0) bg0 = r.truth.bg;
@@ -298,18 +300,19 @@ TEST(SimImu, NoiseAndBiasStatistics) {
 TEST(SimGnss, NoiseFreeFixesHaveZeroResidualsAtTruth) {
   SimOptions options = NoiseFree(Drive());
   options.gnss_rate = 5.0;
-  const std::vector<SimRecord> fixes = OfType(RunAll(options), SimRecord::Type::kGnss);
+  const std::vector<SimRecord> fixes = OfType<GnssRecord>(RunAll(options));
   ASSERT_EQ(fixes.size(), 301u);
   const LocalEnuFrame frame(options.origin);
   for (const SimRecord& r : fixes) {
+    const GnssRecord& fix = r.get<GnssRecord>();
     const NavState& x = r.truth;
-    const Vec3 z_w = frame.ToEnu({r.gnss.lat_deg, r.gnss.lon_deg, r.gnss.alt_m});
+    const Vec3 z_w = frame.ToEnu({fix.lat_deg, fix.lon_deg, fix.alt_m});
     EXPECT_LT(GnssPositionModel::Residual<double>(x.p_wb, x.q_wb, options.lever_b, z_w).norm(), 1e-8);
-    ASSERT_TRUE(r.gnss.heading_valid);
-    EXPECT_NEAR(HeadingModel::Residual<double>(x.q_wb, options.mount_yaw, CompassDegToEnuYaw(r.gnss.heading_deg)),
+    ASSERT_TRUE(fix.heading_valid);
+    EXPECT_NEAR(HeadingModel::Residual<double>(x.q_wb, options.mount_yaw, CompassDegToEnuYaw(fix.heading_deg)),
                 0.0, 1e-10);
-    EXPECT_TRUE(r.gnss.has_sigma);
-    EXPECT_EQ(r.gnss.sigma_enu, options.gnss_sigma_enu);
+    EXPECT_TRUE(fix.has_sigma);
+    EXPECT_EQ(fix.sigma_enu, options.gnss_sigma_enu);
   }
 }
 
@@ -318,18 +321,19 @@ TEST(SimGnss, NoiseMatchesSigma) {
   options.gnss_rate = 20.0;
   options.wheel_rate = 0.0;
   options.imu_rate = 1.0;  // keep the test fast; the IMU plays no part
-  const std::vector<SimRecord> fixes = OfType(RunAll(options), SimRecord::Type::kGnss);
+  const std::vector<SimRecord> fixes = OfType<GnssRecord>(RunAll(options));
   const LocalEnuFrame frame(options.origin);
   Vec3 sum_sq = Vec3::Zero();
   double sum_sq_yaw = 0.0;
   int n_yaw = 0;
   for (const SimRecord& r : fixes) {
+    const GnssRecord& fix = r.get<GnssRecord>();
     const NavState& x = r.truth;
-    const Vec3 z_w = frame.ToEnu({r.gnss.lat_deg, r.gnss.lon_deg, r.gnss.alt_m});
+    const Vec3 z_w = frame.ToEnu({fix.lat_deg, fix.lon_deg, fix.alt_m});
     sum_sq += GnssPositionModel::Residual<double>(x.p_wb, x.q_wb, options.lever_b, z_w).cwiseAbs2();
-    if (r.gnss.heading_valid) {
+    if (fix.heading_valid) {
       sum_sq_yaw += std::pow(
-          HeadingModel::Residual<double>(x.q_wb, options.mount_yaw, CompassDegToEnuYaw(r.gnss.heading_deg)), 2);
+          HeadingModel::Residual<double>(x.q_wb, options.mount_yaw, CompassDegToEnuYaw(fix.heading_deg)), 2);
       ++n_yaw;
     }
   }
@@ -344,11 +348,11 @@ TEST(SimGnss, OutagesHaveNoFixes) {
   SimOptions options = NoiseFree(Drive());
   options.gnss_rate = 10.0;
   options.gnss_outages = {{10.0, 5.0}, {30.05, 2.5}};
-  const std::vector<SimRecord> fixes = OfType(RunAll(options), SimRecord::Type::kGnss);
+  const std::vector<SimRecord> fixes = OfType<GnssRecord>(RunAll(options));
   EXPECT_EQ(fixes.size(), 601u - 50u - 25u);
   bool seen_15 = false;
   for (const SimRecord& r : fixes) {
-    const double s = r.gnss.t - options.start_time;
+    const double s = r.get<GnssRecord>().t - options.start_time;
     EXPECT_FALSE(s > 10.0 - 1e-4 && s < 15.0 - 1e-4) << s;
     EXPECT_FALSE(s > 30.05 - 1e-4 && s < 32.55 - 1e-4) << s;
     seen_15 |= std::abs(s - 15.0) < 1e-4;  // the window is half open
@@ -363,12 +367,13 @@ TEST(SimGnss, OutliersAtConfiguredRateAndMagnitude) {
   options.wheel_rate = 0.0;
   options.gnss_outlier_probability = 0.1;
   options.gnss_outlier_magnitude = 20.0;
-  const std::vector<SimRecord> fixes = OfType(RunAll(options), SimRecord::Type::kGnss);
+  const std::vector<SimRecord> fixes = OfType<GnssRecord>(RunAll(options));
   const LocalEnuFrame frame(options.origin);
   int outliers = 0;
   for (const SimRecord& r : fixes) {
+    const GnssRecord& fix = r.get<GnssRecord>();
     const NavState& x = r.truth;
-    const Vec3 z_w = frame.ToEnu({r.gnss.lat_deg, r.gnss.lon_deg, r.gnss.alt_m});
+    const Vec3 z_w = frame.ToEnu({fix.lat_deg, fix.lon_deg, fix.alt_m});
     const Vec3 res = GnssPositionModel::Residual<double>(x.p_wb, x.q_wb, options.lever_b, z_w);
     const bool is_outlier = res.norm() > 1.0;
     EXPECT_EQ(is_outlier, r.gnss_outlier);
@@ -387,7 +392,7 @@ TEST(SimGnss, OutliersAtConfiguredRateAndMagnitude) {
 
 TEST(SimWheel, PulsesGiveTruthSpeedWithinQuantisation) {
   SimOptions options = NoiseFree(Drive());
-  const std::vector<SimRecord> wheel = OfType(RunAll(options), SimRecord::Type::kWheel);
+  const std::vector<SimRecord> wheel = OfType<WheelRecord>(RunAll(options));
   ASSERT_EQ(wheel.size(), 600u);
   const TruthTrajectory truth(options);
   const double dt = 1.0 / options.wheel_rate;
@@ -395,10 +400,11 @@ TEST(SimWheel, PulsesGiveTruthSpeedWithinQuantisation) {
   const double pulse_speed = WheelSpeedFromPulses(1.0, options.wheel_radius, options.pulses_per_rev, dt);
   double max_err = 0.0;
   for (const SimRecord& r : wheel) {
-    const double left = WheelSpeedFromPulses(r.wheel.left_pulses, options.wheel_radius, options.pulses_per_rev, dt);
-    const double right = WheelSpeedFromPulses(r.wheel.right_pulses, options.wheel_radius, options.pulses_per_rev, dt);
-    EXPECT_EQ(r.wheel.left_pulses, std::round(r.wheel.left_pulses));
-    const double s1 = r.wheel.t - options.start_time;
+    const WheelRecord& wheel_record = r.get<WheelRecord>();
+    const double left = WheelSpeedFromPulses(wheel_record.left_pulses, options.wheel_radius, options.pulses_per_rev, dt);
+    const double right = WheelSpeedFromPulses(wheel_record.right_pulses, options.wheel_radius, options.pulses_per_rev, dt);
+    EXPECT_EQ(wheel_record.left_pulses, std::round(wheel_record.left_pulses));
+    const double s1 = wheel_record.t - options.start_time;
     // The counts measure the mean speed over (t − Δt, t].
     const Vec2 mean = truth.IntegrateSpeedAndYawRate(s1 - dt, s1) / dt;
     max_err = std::max(max_err, std::abs(0.5 * (left + right) / options.wheel_scale - mean.x()));
@@ -413,20 +419,21 @@ TEST(SimWheel, PulsesGiveTruthSpeedWithinQuantisation) {
 // the noise shows.
 TEST(SimWheel, ParkedWheelsCountNothing) {
   const SimOptions options = Drive();
-  const std::vector<SimRecord> wheel = OfType(RunAll(options), SimRecord::Type::kWheel);
+  const std::vector<SimRecord> wheel = OfType<WheelRecord>(RunAll(options));
   const TruthTrajectory truth(options);
   const double dt = 1.0 / options.wheel_rate;
   int parked = 0, rolling = 0;
   double sum_sq = 0.0;
   for (const SimRecord& r : wheel) {
-    const double s1 = r.wheel.t - options.start_time;
+    const WheelRecord& wheel_record = r.get<WheelRecord>();
+    const double s1 = wheel_record.t - options.start_time;
     const double distance = truth.IntegrateSpeedAndYawRate(s1 - dt, s1).x();
     if (distance == 0.0) {
-      EXPECT_EQ(r.wheel.left_pulses, 0.0);
-      EXPECT_EQ(r.wheel.right_pulses, 0.0);
+      EXPECT_EQ(wheel_record.left_pulses, 0.0);
+      EXPECT_EQ(wheel_record.right_pulses, 0.0);
       ++parked;
     } else if (distance > 0.1) {
-      const double v = WheelSpeedFromPulses(0.5 * (r.wheel.left_pulses + r.wheel.right_pulses), options.wheel_radius,
+      const double v = WheelSpeedFromPulses(0.5 * (wheel_record.left_pulses + wheel_record.right_pulses), options.wheel_radius,
                                             options.pulses_per_rev, dt);
       sum_sq += std::pow(v - options.wheel_scale * distance / dt, 2);
       ++rolling;
@@ -444,14 +451,14 @@ TEST(SimWheel, ParkedWheelsCountNothing) {
 
 TEST(SimStream, TimeOrderedWithExpectedCounts) {
   const std::vector<SimRecord> all = RunAll(Drive());
-  EXPECT_EQ(OfType(all, SimRecord::Type::kImu).size(), 6001u);
-  EXPECT_EQ(OfType(all, SimRecord::Type::kGnss).size(), 61u);
-  EXPECT_EQ(OfType(all, SimRecord::Type::kWheel).size(), 600u);
+  EXPECT_EQ(OfType<ImuSample>(all).size(), 6001u);
+  EXPECT_EQ(OfType<GnssRecord>(all).size(), 61u);
+  EXPECT_EQ(OfType<WheelRecord>(all).size(), 600u);
   for (size_t i = 1; i < all.size(); ++i) {
     ASSERT_LE(all[i - 1].t(), all[i].t());
     // Ties: the IMU sample comes first, so a filter has propagated to t before it updates at t.
     if (all[i - 1].t() == all[i].t()) {
-      EXPECT_NE(all[i].type, SimRecord::Type::kImu);
+      EXPECT_FALSE(all[i].is<ImuSample>());
     }
   }
   EXPECT_DOUBLE_EQ(all.front().t(), Drive().start_time);
@@ -464,12 +471,19 @@ TEST(SimRandom, ReproducibleFromSeed) {
   const std::vector<SimRecord> a = RunAll(Drive()), b = RunAll(Drive());
   ASSERT_EQ(a.size(), b.size());
   for (size_t i = 0; i < a.size(); ++i) {
-    ASSERT_EQ(a[i].type, b[i].type);
-    EXPECT_TRUE(SameImu(a[i].imu, b[i].imu));
-    EXPECT_EQ(a[i].wheel.left_pulses, b[i].wheel.left_pulses);
-    EXPECT_EQ(a[i].wheel.right_pulses, b[i].wheel.right_pulses);
-    EXPECT_EQ(a[i].gnss.lat_deg, b[i].gnss.lat_deg);
-    EXPECT_EQ(a[i].gnss.heading_deg, b[i].gnss.heading_deg);
+    ASSERT_EQ(a[i].type_index(), b[i].type_index());
+    EXPECT_EQ(a[i].t(), b[i].t());
+    if (const ImuSample* imu = a[i].get_if<ImuSample>()) {
+      EXPECT_TRUE(SameImu(*imu, b[i].get<ImuSample>()));
+    }
+    if (const WheelRecord* wheel = a[i].get_if<WheelRecord>()) {
+      EXPECT_EQ(wheel->left_pulses, b[i].get<WheelRecord>().left_pulses);
+      EXPECT_EQ(wheel->right_pulses, b[i].get<WheelRecord>().right_pulses);
+    }
+    if (const GnssRecord* fix = a[i].get_if<GnssRecord>()) {
+      EXPECT_EQ(fix->lat_deg, b[i].get<GnssRecord>().lat_deg);
+      EXPECT_EQ(fix->heading_deg, b[i].get<GnssRecord>().heading_deg);
+    }
   }
   SimOptions other = Drive();
   other.seed = 8;
@@ -477,8 +491,8 @@ TEST(SimRandom, ReproducibleFromSeed) {
   ASSERT_EQ(a.size(), c.size());
   int imu_differ = 0, gnss_differ = 0;
   for (size_t i = 0; i < a.size(); ++i) {
-    imu_differ += a[i].type == SimRecord::Type::kImu && !SameImu(a[i].imu, c[i].imu);
-    gnss_differ += a[i].type == SimRecord::Type::kGnss && a[i].gnss.lat_deg != c[i].gnss.lat_deg;
+    imu_differ += a[i].is<ImuSample>() && !SameImu(a[i].get<ImuSample>(), c[i].get<ImuSample>());
+    gnss_differ += a[i].is<GnssRecord>() && a[i].get<GnssRecord>().lat_deg != c[i].get<GnssRecord>().lat_deg;
   }
   EXPECT_EQ(imu_differ, 6001);
   EXPECT_EQ(gnss_differ, 61);
@@ -495,17 +509,20 @@ TEST(SimRandom, SensorStreamsIndependent) {
   changed.gnss_outages = {{20.0, 10.0}};
   changed.wheel_rate = 0.0;
   const std::vector<SimRecord> a = RunAll(base), b = RunAll(changed);
-  const auto imu_a = OfType(a, SimRecord::Type::kImu), imu_b = OfType(b, SimRecord::Type::kImu);
+  const auto imu_a = OfType<ImuSample>(a), imu_b = OfType<ImuSample>(b);
   ASSERT_EQ(imu_a.size(), imu_b.size());
-  for (size_t i = 0; i < imu_a.size(); ++i) ASSERT_TRUE(SameImu(imu_a[i].imu, imu_b[i].imu)) << i;
+  for (size_t i = 0; i < imu_a.size(); ++i) {
+    ASSERT_TRUE(SameImu(imu_a[i].get<ImuSample>(), imu_b[i].get<ImuSample>())) << i;
+  }
   // Fixes that are not outliers in either run are identical.
-  const auto gnss_a = OfType(a, SimRecord::Type::kGnss), gnss_b = OfType(b, SimRecord::Type::kGnss);
+  const auto gnss_a = OfType<GnssRecord>(a), gnss_b = OfType<GnssRecord>(b);
   size_t j = 0, compared = 0;
   for (const SimRecord& r : gnss_b) {
-    while (gnss_a[j].gnss.t < r.gnss.t) ++j;
+    const GnssRecord& fix = r.get<GnssRecord>();
+    while (gnss_a[j].get<GnssRecord>().t < fix.t) ++j;
     if (r.gnss_outlier || gnss_a[j].gnss_outlier) continue;
-    EXPECT_EQ(r.gnss.lat_deg, gnss_a[j].gnss.lat_deg);
-    EXPECT_EQ(r.gnss.alt_m, gnss_a[j].gnss.alt_m);
+    EXPECT_EQ(fix.lat_deg, gnss_a[j].get<GnssRecord>().lat_deg);
+    EXPECT_EQ(fix.alt_m, gnss_a[j].get<GnssRecord>().alt_m);
     ++compared;
   }
   EXPECT_GT(compared, 100u);
@@ -526,7 +543,7 @@ TEST(SimOptionsCheck, RejectsInvalidOptions) {
   EXPECT_THROW(Simulator{sim}, std::invalid_argument);
   sim = Drive();
   sim.gnss_rate = 0.0;  // GNSS off is valid
-  EXPECT_TRUE(OfType(RunAll(sim), SimRecord::Type::kGnss).empty());
+  EXPECT_TRUE(OfType<GnssRecord>(RunAll(sim)).empty());
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -553,9 +570,9 @@ TEST(SimFiles, SimulateWritesParsableLogAndTruth) {
   options.segments.resize(3);  // 18 s
   const std::string dir = test::MakeTempDir("sim") + "/out";  // created by Simulate
   const SimulationResult result = Simulate(options, dir);
-  EXPECT_EQ(result.imu, 1801u);
-  EXPECT_EQ(result.gnss, 19u);
-  EXPECT_EQ(result.wheel, 180u);
+  EXPECT_EQ(CountOf<ImuSample>(result.records), 1801u);
+  EXPECT_EQ(CountOf<GnssRecord>(result.records), 19u);
+  EXPECT_EQ(CountOf<WheelRecord>(result.records), 180u);
   EXPECT_DOUBLE_EQ(result.duration, 18.0);
 
   const std::vector<std::string> log = Lines(test::ReadFile(dir + "/log.txt"));
@@ -575,24 +592,25 @@ TEST(SimFiles, SimulateWritesParsableLogAndTruth) {
     last_t = t;
     if (f[0] == "IMU") {
       ASSERT_EQ(f.size(), 8u) << line;
-      ASSERT_EQ(r.type, SimRecord::Type::kImu);
+      ASSERT_TRUE(r.is<ImuSample>());
+      const ImuSample& imu = r.get<ImuSample>();
       for (int i = 0; i < 3; ++i) {
-        EXPECT_NEAR(std::stod(f[2 + i]), r.imu.gyro[i], 1e-9 * std::abs(r.imu.gyro[i]) + 1e-300);
-        EXPECT_NEAR(std::stod(f[5 + i]), r.imu.acc[i], 1e-9 * std::abs(r.imu.acc[i]) + 1e-300);
+        EXPECT_NEAR(std::stod(f[2 + i]), imu.gyro[i], 1e-9 * std::abs(imu.gyro[i]) + 1e-300);
+        EXPECT_NEAR(std::stod(f[5 + i]), imu.acc[i], 1e-9 * std::abs(imu.acc[i]) + 1e-300);
       }
     } else if (f[0] == "ODOM") {
       ASSERT_EQ(f.size(), 4u) << line;
-      ASSERT_EQ(r.type, SimRecord::Type::kWheel);
-      EXPECT_EQ(std::stod(f[2]), r.wheel.left_pulses);
-      EXPECT_EQ(std::stod(f[3]), r.wheel.right_pulses);
+      ASSERT_TRUE(r.is<WheelRecord>());
+      EXPECT_EQ(std::stod(f[2]), r.get<WheelRecord>().left_pulses);
+      EXPECT_EQ(std::stod(f[3]), r.get<WheelRecord>().right_pulses);
     } else {
       ASSERT_EQ(f[0], "GNSS");
       ASSERT_EQ(f.size(), 10u) << line;
-      ASSERT_EQ(r.type, SimRecord::Type::kGnss);
-      EXPECT_NEAR(std::stod(f[2]), r.gnss.lat_deg, 1e-10);
-      EXPECT_NEAR(std::stod(f[3]), r.gnss.lon_deg, 1e-10);
-      EXPECT_NEAR(std::stod(f[4]), r.gnss.alt_m, 1e-4);
-      EXPECT_EQ(f[6], r.gnss.heading_valid ? "1" : "0");
+      ASSERT_TRUE(r.is<GnssRecord>());
+      EXPECT_NEAR(std::stod(f[2]), r.get<GnssRecord>().lat_deg, 1e-10);
+      EXPECT_NEAR(std::stod(f[3]), r.get<GnssRecord>().lon_deg, 1e-10);
+      EXPECT_NEAR(std::stod(f[4]), r.get<GnssRecord>().alt_m, 1e-4);
+      EXPECT_EQ(f[6], r.get<GnssRecord>().heading_valid ? "1" : "0");
       EXPECT_NEAR(std::stod(f[9]), options.gnss_sigma_enu.z(), 1e-12);
     }
   }

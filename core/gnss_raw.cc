@@ -2,6 +2,7 @@
 #include "core/gnss_raw.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -218,6 +219,38 @@ void DifferenceByGroup(const NuisanceRows& rows, VecX* r_d, MatX* H_d, MatX* R_d
     for (const auto& [group, c] : count) used += c >= 2 ? 1 : 0;
     *groups_used = used;
   }
+}
+
+double PhaseRangeChange(const RawSatellite& now, const RawSatellite& prev) {
+  return now.phase_m - prev.phase_m + kSpeedOfLight * (now.sat_clock_s - prev.sat_clock_s);
+}
+
+bool PhaseSlipped(const RawSatellite& now, const RawSatellite& prev, double dt) {
+  if (now.lost_lock) return true;
+  if (!now.has_rate || !prev.has_rate) return false;
+  const double from_doppler = 0.5 * (now.rate_m_s + prev.rate_m_s) * dt;
+  const double bound = 5.0 * std::hypot(now.rate_sigma_m_s, prev.rate_sigma_m_s) * dt + 0.05;
+  return !(std::abs(PhaseRangeChange(now, prev) - from_doppler) <= bound);
+}
+
+LinearConstraint3 CompressRows(const VecX& r_d, const MatX& H_d, const MatX& R_d, const Vec3& x0) {
+  LinearConstraint3 c;
+  c.z = x0;
+  if (r_d.size() == 0) return c;
+  const Eigen::LLT<MatX> llt(R_d);
+  const MatX W = llt.matrixL().solve(H_d);
+  const VecX e = llt.matrixL().solve(r_d);
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(W.transpose() * W);
+  const Vec3 b = W.transpose() * e;
+  const double largest = eig.eigenvalues().maxCoeff();
+  for (int i = 0; i < 3; ++i) {
+    const double lambda = eig.eigenvalues()(i);
+    if (!(lambda > 1e-9 * largest)) continue;
+    const Vec3 v = eig.eigenvectors().col(i);
+    c.sqrt_info.row(c.rank++) = std::sqrt(lambda) * v.transpose();
+    c.z -= v * (v.dot(b) / lambda);
+  }
+  return c;
 }
 
 }  // namespace gins

@@ -115,6 +115,16 @@ double RateResidual(const RawSatellite& s, const Vec3& r_rx_ecef, const Vec3& v_
 bool SolveDopplerVelocity(const std::vector<RawSatellite>& sats, const Vec3& r_rx_ecef, double w_max,
                           Vec3* v_rx_ecef, Mat3* cov, int* used = nullptr);
 
+// Carrier phase differenced in time between two epochs of one satellite (each estimator's TDCP): the range's
+// change plus the receiver clock's, λ·(φ_now − φ_prev) + c·(Δt_sv,now − Δt_sv,prev) (the ambiguity, constant
+// while locked, cancels; the atmosphere's change over an epoch is neglected), m. Differences over more than
+// kMaxPhaseInterval end the chain.
+constexpr double kMaxPhaseInterval = 2.0;  // s
+double PhaseRangeChange(const RawSatellite& now, const RawSatellite& prev);
+// A cycle slip between the epochs dt apart: lost lock, or a phase change the mean of the two Dopplers does
+// not explain (beyond 5 σ of their difference over dt, plus 5 cm).
+bool PhaseSlipped(const RawSatellite& now, const RawSatellite& prev, double dt);
+
 // Rows of residuals (predicted − measured), each in a nuisance group (its clock: the system for ranges,
 // one group for range rates) with its variance; H: their Jacobian (rows × state dimension).
 struct NuisanceRows {
@@ -133,5 +143,18 @@ std::vector<int> ScreenSatellites(const NuisanceRows& rows, const MatX& P, doubl
 // The rows' differences within each group against the group's row of least variance (groups of one row
 // drop out): r_d, H_d, and their noise R_d = D·diag(variance)·Dᵀ. *groups_used: the groups left.
 void DifferenceByGroup(const NuisanceRows& rows, VecX* r_d, MatX* H_d, MatX* R_d, int* groups_used = nullptr);
+
+// Rows over a 3-vector x (r_d + H_d·(x − x0), noise R_d; x0 where they were evaluated) as the one constraint
+// they put on x: ‖S·(x − z)‖² equals their whitened squared norm up to a constant. S (3×3) is the square root
+// of the information H_dᵀ·R_d⁻¹·H_d, with a zero row for each direction the rows do not see (eigenvalue below
+// 1e-9 of the largest: two satellites of one system see one), z their least-squares x with no change from
+// x0 in those directions; rank: S's nonzero rows. Exact for rows linear in x: a pseudorange's line of sight
+// moves by |δx|/ρ, so a metre off x0 costs 10⁻⁸ m.
+struct LinearConstraint3 {
+  Vec3 z = Vec3::Zero();
+  Mat3 sqrt_info = Mat3::Zero();
+  int rank = 0;
+};
+LinearConstraint3 CompressRows(const VecX& r_d, const MatX& H_d, const MatX& R_d, const Vec3& x0);
 
 }  // namespace gins

@@ -17,6 +17,7 @@
 #include "factors/gnss_velocity_factor.h"
 #include "factors/odometer_factor.h"
 #include "factors/preint_attached_factor.h"
+#include "factors/raw_gnss_factor.h"
 #include "factors/wheel_yaw_factor.h"
 #include "factors/heading_factor.h"
 #include "factors/nhc_factor.h"
@@ -69,6 +70,21 @@ ceres::CostFunction* PreintAttachedFactor<Measurement>::CreateAutoDiff(std::shar
 template class PreintAttachedFactor<GnssAtTime>;
 template class PreintAttachedFactor<HeadingAtTime>;
 template class PreintAttachedFactor<GnssVelocityAtTime>;
+template class PreintAttachedFactor<RawRangeAtTime>;
+template class PreintAttachedFactor<RawRateAtTime>;
+
+template <class M>
+ceres::CostFunction* RawAtKeyframeFactor<M>::Create(M model) {
+  return new ceres::AutoDiffCostFunction<RawAtKeyframeFactor<M>, 3, pose::kAmbient, 3>(
+      new RawAtKeyframeFactor<M>(std::move(model)));
+}
+template class RawAtKeyframeFactor<RawRangeAtTime>;
+template class RawAtKeyframeFactor<RawRateAtTime>;
+
+ceres::CostFunction* RawDisplacementFactor::Create(const Vec3& d_w, const Mat3& sqrt_info, const Vec3& lever_b) {
+  return new ceres::AutoDiffCostFunction<RawDisplacementFactor, 3, pose::kAmbient, pose::kAmbient>(
+      new RawDisplacementFactor(d_w, sqrt_info, lever_b));
+}
 
 template <class Measurement>
 ceres::CostFunction* DelayedAtKeyframeFactor<Measurement>::Create(Delayed<Measurement> delayed) {

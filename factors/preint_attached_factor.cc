@@ -5,6 +5,7 @@
 
 #include "core/so3.h"
 #include "factors/delayed_factor.h"
+#include "factors/raw_gnss_factor.h"
 
 namespace gins {
 namespace {
@@ -181,6 +182,8 @@ ceres::CostFunction* DelayedAttachedCostFunction<Measurement>::CreateAutoDiff(
 template class PreintAttachedCostFunction<GnssAtTime>;
 template class PreintAttachedCostFunction<HeadingAtTime>;
 template class PreintAttachedCostFunction<GnssVelocityAtTime>;
+template class PreintAttachedCostFunction<RawRangeAtTime>;
+template class PreintAttachedCostFunction<RawRateAtTime>;
 template class DelayedAttachedCostFunction<GnssAtTime>;
 template class DelayedAttachedCostFunction<HeadingAtTime>;
 template class DelayedAttachedCostFunction<GnssVelocityAtTime>;

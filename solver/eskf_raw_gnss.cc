@@ -152,12 +152,7 @@ nlohmann::json Eskf::RawGnssCounts::ToJson() const {
 
 namespace gins {
 
-namespace {
-constexpr double kMaxPhaseInterval = 2.0;  // s: a longer gap between epochs ends the phases' chain
-}  // namespace
-
-// Carrier phase differenced in time: λ·(φ_k − φ_k−1) + c·(Δt_sv,k − Δt_sv,k−1) = ρ_k − ρ_k−1 + c·Δdt_r (the
-// ambiguity, constant while locked, cancels; the atmosphere's change over an epoch is neglected). ρ_k−1 is
+// Carrier phase differenced in time (core/gnss_raw.h, PhaseRangeChange) = ρ_k − ρ_k−1 + c·Δdt_r. ρ_k−1 is
 // taken from the antenna now less the displacement since the previous epoch, and the displacement's error
 // from the state now: δD = Δt·δv + ½Δt²·([f_w]×·R_wb·δθ + R_wb·δba) (the velocity error's own rate over the
 // interval, δv̇ = −R[f]×δθ − R·δba). The receiver clock's change is one for every satellite: one group.
@@ -176,20 +171,11 @@ void Eskf::UpdateRawPhase(const RawGnssMeasurement& m, const std::vector<RawSate
       if (!s.has_phase) continue;
       const auto prev = phase_epoch_.sats.find(s.sat.ToString());
       if (prev == phase_epoch_.sats.end()) continue;
-      const RawSatellite& q = prev->second;
-      const double measured = s.phase_m - q.phase_m + kSpeedOfLight * (s.sat_clock_s - q.sat_clock_s);
-      // A slip: lost lock, or a phase change the Doppler does not explain.
-      bool slip = s.lost_lock;
-      if (s.has_rate && q.has_rate) {
-        const double from_doppler = 0.5 * (s.rate_m_s + q.rate_m_s) * dt;
-        const double bound = 5.0 * std::hypot(s.rate_sigma_m_s, q.rate_sigma_m_s) * dt + 0.05;
-        slip = slip || !(std::abs(measured - from_doppler) <= bound);
-      }
-      if (slip) {
+      if (PhaseSlipped(s, prev->second, dt)) {
         ++raw_.phase_slips;
         continue;
       }
-      pairs.push_back({&s, &q});
+      pairs.push_back({&s, &prev->second});
     }
     auto rows_at = [&](const EskfNominal& x) {
       const Vec3 d_theta = LogQuat<double>(x0.x.q_wb.conjugate() * x.x.q_wb);
@@ -209,8 +195,7 @@ void Eskf::UpdateRawPhase(const RawGnssMeasurement& m, const std::vector<RawSate
         const RawSatellite& s = *pairs[i].first;
         const RawSatellite& q = *pairs[i].second;
         const Vec3 a = s.r_sat_ecef - r_now, b = q.r_sat_ecef - r_prev;
-        const double measured = s.phase_m - q.phase_m + kSpeedOfLight * (s.sat_clock_s - q.sat_clock_s);
-        rows.r(i) = a.norm() - b.norm() - measured;
+        rows.r(i) = a.norm() - b.norm() - PhaseRangeChange(s, q);
         const Eigen::RowVector3d u_now = (a / a.norm()).transpose() * m.R_ecef_w;
         const Eigen::RowVector3d u_prev = (b / b.norm()).transpose() * m.R_ecef_w;
         // r_prev moves with p and against D; r_now with p and the lever's turn.

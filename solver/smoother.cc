@@ -11,6 +11,7 @@
 #include "factors/imu_factor.h"
 #include "solver/batch_smoother.h"
 #include "solver/marginalizer.h"
+#include "solver/raw_gnss_attacher.h"
 #include "solver/smoother_gate.h"
 #include "solver/smoother_output.h"
 #include "solver/summary_keys.h"
@@ -44,7 +45,8 @@ Smoother::Smoother(const SensorOptions& sensors, const EskfOptions& eskf, const 
                [this](double t) { return AnchorAt(t); },
                [this]() -> const MatX* { return newest_two_cov_.size() > 0 ? &newest_two_cov_ : nullptr; },
                [this](double t) { return PartialAt(t); },
-               [this](double t) { return PredictStateAt(t); }},
+               [this](double t) { return PredictStateAt(t); },
+               [this](double t) { return AnchorAt(t, /*keyframe=*/true); }},
       watchdog_(watchdog) {
   window_.SetLog(factor_log_.get());
   attachers_.push_back(std::make_unique<VehicleAttacher>(sensors_));
@@ -54,6 +56,7 @@ Smoother::Smoother(const SensorOptions& sensors, const EskfOptions& eskf, const 
   attachers_.push_back(std::make_unique<GnssAttacher>(
       sensors_.gnss, [this](double t, bool accepted) { WatchGnss(t, accepted); },
       [this](double factor) { RelievePrior(factor); }));
+  attachers_.push_back(std::make_unique<RawGnssAttacher>(sensors_.gnss));
   pre_init_.SetBackwardFiller([this](const BackwardSpan& span) {
     return FillBackward(sensors_, eskf_options_, standstill_options_, span);
   });
@@ -190,11 +193,11 @@ bool Smoother::BeyondNewest(double t) const {
   return t - window_.back().t > kSameEpoch && preint_->dt() > 0.0;
 }
 
-Anchor Smoother::AnchorAt(double t) {
+Anchor Smoother::AnchorAt(double t, bool keyframe) {
   Keyframe& newest = window_.back();
   if (std::abs(t - newest.t) <= kSameEpoch) return {&newest, nullptr};
   IntegrateTo(t);
-  if (t - newest.t >= smoother_options_.min_keyframe_interval || preint_->dt() <= 0.0) {
+  if (keyframe || t - newest.t >= smoother_options_.min_keyframe_interval || preint_->dt() <= 0.0) {
     Keyframe& kf = CreateKeyframe(t);
     return {&kf, nullptr};
   }
@@ -283,6 +286,12 @@ void Smoother::Use(const StandstillMeasurement& x, const Measurement& m) {
 
 void Smoother::Use(const GnssVelocityMeasurement& x, const Measurement& m) {
   if (!initialized_ || x.t < t_now_ - kSameEpoch || x.t < window_.back().t - kSameEpoch) return;
+  if (x.t > window_.back().t + kSameEpoch) SolveIfPending();
+  if (Attach(m)) solve_pending_ = true;
+}
+
+void Smoother::Use(const RawGnssMeasurement& x, const Measurement& m) {
+  if (!initialized_ || !x.nav || x.t < t_now_ - kSameEpoch || x.t < window_.back().t - kSameEpoch) return;
   if (x.t > window_.back().t + kSameEpoch) SolveIfPending();
   if (Attach(m)) solve_pending_ = true;
 }

@@ -78,12 +78,8 @@ class Smoother : public Estimator {
   void Use(const GnssVelocityMeasurement& x, const Measurement& m);
   void Use(const WheelMeasurement& x, const Measurement& m);
   void Use(const StandstillMeasurement& x, const Measurement& m);
-  // The epoch's single-point fix and Doppler velocity, as a fix and a GNSS velocity: the smoother has no
-  // raw updates yet.
-  void Use(const RawGnssMeasurement& x, const Measurement& /*m*/) {
-    if (x.has_fix) Add(x.fix);
-    if (x.has_velocity && sensors_.gnss.use_velocity) Add(x.velocity);
-  }
+  // A raw epoch: its pseudoranges and range rates (solver/raw_gnss_attacher.h).
+  void Use(const RawGnssMeasurement& x, const Measurement& m);
   // Offers m to every attacher; true if one asks for a solve before the next IMU sample.
   bool Attach(const Measurement& m);
   void IntegrateTo(double t, const ImuSample* held = nullptr);
@@ -93,7 +89,7 @@ class Smoother : public Estimator {
   NavState PredictStateAt(double t);
   // t is past the newest keyframe's epoch and the IMU integrated from it (the prediction is pred_).
   bool BeyondNewest(double t) const;
-  Anchor AnchorAt(double t);
+  Anchor AnchorAt(double t, bool keyframe = false);  // keyframe: a keyframe at t, whatever the policy
   Anchor PartialAt(double t);
   // Solves the window if measurements joined it since the last solve.
   void SolveIfPending();

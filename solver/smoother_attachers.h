@@ -80,6 +80,9 @@ struct AttachContext {
   // The state `predict` gives, without its covariance (a fraction of the cost): for what needs only the
   // attitude or the biases at t.
   std::function<NavState(double t)> predict_state;
+  // A keyframe at t whatever smoother.min_keyframe_interval_s says (the newest if t is its epoch): for a
+  // measurement between two epochs' states, which must be keyframes.
+  std::function<Anchor(double t)> keyframe;
   // The Earth terms of an IMU interval around p (gravity there, Earth rate).
   ImuEarthTerms EarthTermsAt(const Vec3& p_w) const;
   // The body's rate against w from the last IMU sample, with the biases of x.

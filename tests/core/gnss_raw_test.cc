@@ -131,6 +131,60 @@ TEST(GnssRaw, DifferencingIsTheUpdateWithAFreeClockPerGroup) {
   EXPECT_LT((P_post - Pa_post.topLeftCorner(dim, dim)).norm(), 1e-5 * P.norm());
 }
 
+// ‖S·(x − z)‖² − (whitened squared norm of the rows at x): the same at every x when S, z hold the rows.
+double CompressionGap(const LinearConstraint3& c, const VecX& r_d, const MatX& H_d, const MatX& R_d,
+                      const Vec3& x0, const Vec3& x) {
+  const Eigen::LLT<MatX> llt(R_d);
+  const VecX e = llt.matrixL().solve(r_d + H_d * (x - x0));
+  return (c.sqrt_info * (x - c.z)).squaredNorm() - e.squaredNorm();
+}
+
+TEST(GnssRaw, CompressedRowsKeepTheirQuadraticFormAndLeastSquaresPoint) {
+  std::mt19937 rng(11);
+  const int rows_n = 7;
+  const MatX H = RandomMatrix(rows_n, 3, &rng);
+  const MatX A = RandomMatrix(rows_n, rows_n, &rng);
+  const MatX R = A * A.transpose() + MatX::Identity(rows_n, rows_n);
+  const VecX r = RandomMatrix(rows_n, 1, &rng);
+  const Vec3 x0(3.0, -2.0, 7.0);
+  const LinearConstraint3 c = CompressRows(r, H, R, x0);
+  EXPECT_EQ(c.rank, 3);
+  // z is the generalised least-squares x: r + H·(z − x0) = 0 in R⁻¹'s norm.
+  const MatX Ri = R.inverse();
+  const Vec3 z = x0 - (H.transpose() * Ri * H).ldlt().solve(H.transpose() * Ri * r);
+  EXPECT_LT((c.z - z).norm(), 1e-9 * (1.0 + z.norm()));
+  const double gap0 = CompressionGap(c, r, H, R, x0, x0);
+  for (int k = 0; k < 5; ++k) {
+    const Vec3 x = x0 + Vec3(RandomMatrix(3, 1, &rng)) * 4.0;
+    EXPECT_NEAR(CompressionGap(c, r, H, R, x0, x), gap0, 1e-8 * (1.0 + std::abs(gap0))) << k;
+  }
+}
+
+TEST(GnssRaw, CompressedRowsOfOneDirectionHaveRankOne) {
+  // Two satellites of one system: one difference, one direction seen; the others stay free (zero rows).
+  std::mt19937 rng(13);
+  const MatX H = RandomMatrix(1, 3, &rng);
+  const MatX R = MatX::Constant(1, 1, 0.8);
+  const VecX r = VecX::Constant(1, 2.5);
+  const Vec3 x0(1.0, 2.0, 3.0);
+  const LinearConstraint3 c = CompressRows(r, H, R, x0);
+  ASSERT_EQ(c.rank, 1);
+  EXPECT_LT(c.sqrt_info.bottomRows(2).norm(), 1e-15);
+  // z moves from x0 along the seen direction only, to where the row reads zero.
+  const Vec3 h = H.row(0).transpose();
+  EXPECT_NEAR(r(0) + h.dot(c.z - x0), 0.0, 1e-9);
+  EXPECT_LT(((c.z - x0) - h * (h.dot(c.z - x0) / h.squaredNorm())).norm(), 1e-9);
+  const double gap0 = CompressionGap(c, r, H, R, x0, x0);
+  for (int k = 0; k < 5; ++k) {
+    const Vec3 x = x0 + Vec3(RandomMatrix(3, 1, &rng)) * 4.0;
+    EXPECT_NEAR(CompressionGap(c, r, H, R, x0, x), gap0, 1e-8 * (1.0 + std::abs(gap0))) << k;
+  }
+  // No rows: no constraint, z at x0.
+  const LinearConstraint3 none = CompressRows(VecX(), MatX(0, 3), MatX(0, 0), x0);
+  EXPECT_EQ(none.rank, 0);
+  EXPECT_EQ(none.z, x0);
+}
+
 TEST(GnssRaw, DopplerVelocityFromSimulatedEpochs) {
   const std::vector<KeplerEphemeris> ephs =
       ReadRinexNav(std::string(GINS_TEST_DATA_DIR) + "/rinex/walk.nav", InputOptions{}).kepler;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "factor_test_util.h"
+#include "factors/raw_gnss_factor.h"
 
 namespace gins {
 namespace {
@@ -67,6 +68,31 @@ TEST(PreintAttachedCostFunctionTest, HeadingMatchesAutodiffAndNumeric) {
 TEST(PreintAttachedCostFunctionTest, GnssVelocityMatchesAutodiffAndNumeric) {
   ExpectAnalyticMatches(
       GnssVelocityAtTime{Vec3(9.0, -3.0, 2.5), Vec3(10.0, 10.0, 5.0), Vec3(0.1, -0.2, 0.4), Vec3(0.3, -0.2, 1.1)}, "gvel");
+}
+
+// A raw epoch's constraint: full rank, and rank 2 (a zero row: a direction the satellites do not see).
+Mat3 SomeSqrtInfo(int rank) {
+  Mat3 s;
+  s << 2.0, -0.5, 0.3, 0.1, 1.5, -0.7, 0.4, 0.2, 0.9;
+  s.bottomRows(3 - rank).setZero();
+  return s;
+}
+
+TEST(PreintAttachedCostFunctionTest, RawRangeMatchesAutodiffAndNumeric) {
+  for (int rank : {3, 2}) {
+    ExpectAnalyticMatches(
+        RawRangeAtTime{GnssAtTime{Vec3(20.0, -1.0, 0.5), Vec3::Ones(), Vec3(0.3, -0.2, 1.1)}, SomeSqrtInfo(rank)},
+        "raw range rank " + std::to_string(rank));
+  }
+}
+
+TEST(PreintAttachedCostFunctionTest, RawRateMatchesAutodiffAndNumeric) {
+  for (int rank : {3, 1}) {
+    ExpectAnalyticMatches(RawRateAtTime{GnssVelocityAtTime{Vec3(9.0, -3.0, 2.5), Vec3::Ones(), Vec3(0.1, -0.2, 0.4),
+                                                           Vec3(0.3, -0.2, 1.1)},
+                                        SomeSqrtInfo(rank)},
+                          "raw rate rank " + std::to_string(rank));
+  }
 }
 
 }  // namespace

@@ -29,7 +29,8 @@ class AttacherTest : public ::testing::Test {
                  [this](double t) { return Anchor(t); },
                  [this]() -> const MatX* { return two_.size() > 0 ? &two_ : nullptr; },
                  [this](double t) { return Anchor(t); },
-                 [this](double t) { return Predict(t).x; }} {
+                 [this](double t) { return Predict(t).x; },
+                 [this](double t) { return Anchor(t); }} {
     sensors_.gnss.lever_b = Vec3::Zero();
     sensors_.wheel.lever_b = Vec3::Zero();
     store_.Reset(&problem_);

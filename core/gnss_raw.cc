@@ -233,6 +233,30 @@ bool PhaseSlipped(const RawSatellite& now, const RawSatellite& prev, double dt) 
   return !(std::abs(PhaseRangeChange(now, prev) - from_doppler) <= bound);
 }
 
+std::map<std::string, RawSatellite> PhasesByName(const std::vector<RawSatellite>& sats) {
+  std::map<std::string, RawSatellite> out;
+  for (const RawSatellite& s : sats) {
+    if (s.has_phase) out[s.sat.ToString()] = s;
+  }
+  return out;
+}
+
+std::vector<PhasePair> UnbrokenPhases(const std::vector<RawSatellite>& now,
+                                      const std::map<std::string, RawSatellite>& prev, double dt, uint64_t* slips) {
+  std::vector<PhasePair> pairs;
+  for (const RawSatellite& s : now) {
+    if (!s.has_phase) continue;
+    const auto q = prev.find(s.sat.ToString());
+    if (q == prev.end()) continue;
+    if (PhaseSlipped(s, q->second, dt)) {
+      ++*slips;
+      continue;
+    }
+    pairs.push_back({&s, &q->second});
+  }
+  return pairs;
+}
+
 LinearConstraint3 CompressRows(const VecX& r_d, const MatX& H_d, const MatX& R_d, const Vec3& x0) {
   LinearConstraint3 c;
   c.z = x0;

@@ -124,6 +124,13 @@ double PhaseRangeChange(const RawSatellite& now, const RawSatellite& prev);
 // A cycle slip between the epochs dt apart: lost lock, or a phase change the mean of the two Dopplers does
 // not explain (beyond 5 σ of their difference over dt, plus 5 cm).
 bool PhaseSlipped(const RawSatellite& now, const RawSatellite& prev, double dt);
+// An epoch's satellites with a phase, by name ("G05"): what the next epoch differences against.
+std::map<std::string, RawSatellite> PhasesByName(const std::vector<RawSatellite>& sats);
+// The (now, previous) pairs of the satellites with a phase in both epochs, dt apart, that did not slip;
+// *slips counts those that did.
+using PhasePair = std::pair<const RawSatellite*, const RawSatellite*>;
+std::vector<PhasePair> UnbrokenPhases(const std::vector<RawSatellite>& now,
+                                      const std::map<std::string, RawSatellite>& prev, double dt, uint64_t* slips);
 
 // Rows of residuals (predicted − measured), each in a nuisance group (its clock: the system for ranges,
 // one group for range rates) with its variance; H: their Jacobian (rows × state dimension).

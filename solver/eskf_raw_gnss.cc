@@ -166,17 +166,7 @@ void Eskf::UpdateRawPhase(const RawGnssMeasurement& m, const std::vector<RawSate
     // The propagation's displacement of the body (the updates' corrections since taken out).
     const Vec3 D0 = x0.x.p_wb - phase_epoch_.p_wb - position_corrections_;
     const Vec3 lever_prev_w = phase_epoch_.q_wb * lever_b;
-    std::vector<std::pair<const RawSatellite*, const RawSatellite*>> pairs;  // (now, previous)
-    for (const RawSatellite& s : sats) {
-      if (!s.has_phase) continue;
-      const auto prev = phase_epoch_.sats.find(s.sat.ToString());
-      if (prev == phase_epoch_.sats.end()) continue;
-      if (PhaseSlipped(s, prev->second, dt)) {
-        ++raw_.phase_slips;
-        continue;
-      }
-      pairs.push_back({&s, &prev->second});
-    }
+    std::vector<PhasePair> pairs = UnbrokenPhases(sats, phase_epoch_.sats, dt, &raw_.phase_slips);
     auto rows_at = [&](const EskfNominal& x) {
       const Vec3 d_theta = LogQuat<double>(x0.x.q_wb.conjugate() * x.x.q_wb);
       const Vec3 D = D0 + dt * (x.x.v_w - x0.x.v_w) +
@@ -232,10 +222,7 @@ void Eskf::UpdateRawPhase(const RawGnssMeasurement& m, const std::vector<RawSate
   phase_epoch_.t = m.t;
   phase_epoch_.p_wb = nom_.x.p_wb;
   phase_epoch_.q_wb = nom_.x.q_wb;
-  phase_epoch_.sats.clear();
-  for (const RawSatellite& s : sats) {
-    if (s.has_phase) phase_epoch_.sats[s.sat.ToString()] = s;
-  }
+  phase_epoch_.sats = PhasesByName(sats);
   position_corrections_.setZero();
 }
 

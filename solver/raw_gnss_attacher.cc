@@ -171,17 +171,7 @@ bool RawGnssAttacher::AttachPhases(const RawGnssMeasurement& m, const std::vecto
   const bool chained = phase_epoch_.kf != nullptr && dt > 0.0 && dt <= kMaxPhaseInterval;
   bool attached = false;
   if (chained && phase_epoch_.kf != anchor.kf) {
-    std::vector<std::pair<const RawSatellite*, const RawSatellite*>> pairs;  // (now, previous)
-    for (const RawSatellite& s : sats) {
-      if (!s.has_phase) continue;
-      const auto prev = phase_epoch_.sats.find(s.sat.ToString());
-      if (prev == phase_epoch_.sats.end()) continue;
-      if (PhaseSlipped(s, prev->second, dt)) {
-        ++phase_slips_;
-        continue;
-      }
-      pairs.push_back({&s, &prev->second});
-    }
+    const std::vector<PhasePair> pairs = UnbrokenPhases(sats, phase_epoch_.sats, dt, &phase_slips_);
     // Rows in the antenna's displacement D from the previous keyframe's (at its estimate now) to the
     // predicted one; the previous antenna's own error moves both ranges alike (by |δ|·|Δu| ~ 1e-7·|δ|).
     const NavState x_i = phase_epoch_.kf->State();
@@ -224,10 +214,7 @@ bool RawGnssAttacher::AttachPhases(const RawGnssMeasurement& m, const std::vecto
   // This epoch is the next one's previous.
   phase_epoch_.kf = anchor.kf;
   phase_epoch_.t = m.t;
-  phase_epoch_.sats.clear();
-  for (const RawSatellite& s : sats) {
-    if (s.has_phase) phase_epoch_.sats[s.sat.ToString()] = s;
-  }
+  phase_epoch_.sats = PhasesByName(sats);
   return attached;
 }
 

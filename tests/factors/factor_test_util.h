@@ -38,6 +38,15 @@ inline PoseBlock RandomPose(std::mt19937& rng) {
   return MakePose(RandomVec3(rng, 10.0), ExpQuat<double>(RandomVec3(rng, 1.0)));
 }
 
+// A square-root information of a raw GNSS constraint (factors/raw_gnss_factor.h) of the given rank: its
+// rows past the rank zero, the directions the satellites do not see.
+inline Mat3 SqrtInfoOfRank(int rank) {
+  Mat3 s;
+  s << 2.0, -0.5, 0.3, 0.1, 1.5, -0.7, 0.4, 0.2, 0.9;
+  s.bottomRows(3 - rank).setZero();
+  return s;
+}
+
 // Pose x ⊞ δ (PoseManifold::Plus).
 inline PoseBlock PosePlus(const PoseBlock& x, const Vec6& delta) {
   PoseBlock y;

@@ -70,18 +70,12 @@ TEST(PreintAttachedCostFunctionTest, GnssVelocityMatchesAutodiffAndNumeric) {
       GnssVelocityAtTime{Vec3(9.0, -3.0, 2.5), Vec3(10.0, 10.0, 5.0), Vec3(0.1, -0.2, 0.4), Vec3(0.3, -0.2, 1.1)}, "gvel");
 }
 
-// A raw epoch's constraint: full rank, and rank 2 (a zero row: a direction the satellites do not see).
-Mat3 SomeSqrtInfo(int rank) {
-  Mat3 s;
-  s << 2.0, -0.5, 0.3, 0.1, 1.5, -0.7, 0.4, 0.2, 0.9;
-  s.bottomRows(3 - rank).setZero();
-  return s;
-}
-
+// A raw epoch's constraint at full rank and below (zero rows: directions the satellites do not see).
 TEST(PreintAttachedCostFunctionTest, RawRangeMatchesAutodiffAndNumeric) {
   for (int rank : {3, 2}) {
     ExpectAnalyticMatches(
-        RawRangeAtTime{GnssAtTime{Vec3(20.0, -1.0, 0.5), Vec3::Ones(), Vec3(0.3, -0.2, 1.1)}, SomeSqrtInfo(rank)},
+        RawRangeAtTime{GnssAtTime{Vec3(20.0, -1.0, 0.5), Vec3::Ones(), Vec3(0.3, -0.2, 1.1)},
+                       test::SqrtInfoOfRank(rank)},
         "raw range rank " + std::to_string(rank));
   }
 }
@@ -90,7 +84,7 @@ TEST(PreintAttachedCostFunctionTest, RawRateMatchesAutodiffAndNumeric) {
   for (int rank : {3, 1}) {
     ExpectAnalyticMatches(RawRateAtTime{GnssVelocityAtTime{Vec3(9.0, -3.0, 2.5), Vec3::Ones(), Vec3(0.1, -0.2, 0.4),
                                                            Vec3(0.3, -0.2, 1.1)},
-                                        SomeSqrtInfo(rank)},
+                                        test::SqrtInfoOfRank(rank)},
                           "raw rate rank " + std::to_string(rank));
   }
 }

@@ -14,13 +14,6 @@
 namespace gins {
 namespace {
 
-Mat3 SqrtInfoOfRank(int rank) {
-  Mat3 s;
-  s << 2.0, -0.5, 0.3, 0.1, 1.5, -0.7, 0.4, 0.2, 0.9;
-  s.bottomRows(3 - rank).setZero();
-  return s;
-}
-
 TEST(RawGnssFactorTest, RangeResidualIsTheWhitenedAntennaOffset) {
   std::mt19937 rng(21);
   const Vec3 lever_b(0.0, 0.05, 0.3);
@@ -28,14 +21,16 @@ TEST(RawGnssFactorTest, RangeResidualIsTheWhitenedAntennaOffset) {
   const Vec3 vel(1.0, -0.5, 0.1);
   const Vec3 antenna = PosePosition(pose.data()) + Quat(PoseRotation(pose.data())) * lever_b;
   const Vec3 offset(0.4, -0.3, 0.2);
-  const Mat3 S = SqrtInfoOfRank(2);
-  const RawAtKeyframeFactor<RawRangeAtTime> factor(RawRangeAtTime{GnssAtTime{antenna - offset, Vec3::Ones(), lever_b}, S});
+  const Mat3 S = test::SqrtInfoOfRank(2);
+  const RawAtKeyframeFactor<RawRangeAtTime> factor(
+      RawRangeAtTime{GnssAtTime{antenna - offset, Vec3::Ones(), lever_b}, S});
   Vec3 r;
   ASSERT_TRUE(factor(pose.data(), vel.data(), r.data()));
   EXPECT_LT((r - S * offset).norm(), 1e-9);
   // Along S's null direction the antenna may move freely.
-  const Vec3 free = S.topRows(2).row(0).transpose().cross(S.topRows(2).row(1).transpose()).normalized();
-  const RawAtKeyframeFactor<RawRangeAtTime> blind(RawRangeAtTime{GnssAtTime{antenna + 5.0 * free, Vec3::Ones(), lever_b}, S});
+  const Vec3 free = S.row(0).transpose().cross(S.row(1).transpose()).normalized();
+  const RawAtKeyframeFactor<RawRangeAtTime> blind(
+      RawRangeAtTime{GnssAtTime{antenna + 5.0 * free, Vec3::Ones(), lever_b}, S});
   ASSERT_TRUE(blind(pose.data(), vel.data(), r.data()));
   EXPECT_LT(r.norm(), 1e-9);
 }
@@ -52,12 +47,12 @@ TEST(RawGnssFactorTest, JacobiansMatchNumeric) {
     const Vec3 z = PosePosition(pose.data()) + test::RandomVec3(rng, 1.0);
     const std::string what = "rank " + std::to_string(rank);
     std::unique_ptr<ceres::CostFunction> range(RawAtKeyframeFactor<RawRangeAtTime>::Create(
-        RawRangeAtTime{GnssAtTime{z, Vec3::Ones(), lever_b}, SqrtInfoOfRank(rank)}));
+        RawRangeAtTime{GnssAtTime{z, Vec3::Ones(), lever_b}, test::SqrtInfoOfRank(rank)}));
     worst = std::max(worst, test::CheckJacobians(*range, {&manifold, nullptr}, {pose.data(), vel.data()}, 1e-6,
                                                  "raw range " + what));
     std::unique_ptr<ceres::CostFunction> rate(RawAtKeyframeFactor<RawRateAtTime>::Create(
         RawRateAtTime{GnssVelocityAtTime{test::RandomVec3(rng, 3.0), Vec3::Ones(), omega_b, lever_b},
-                      SqrtInfoOfRank(rank)}));
+                      test::SqrtInfoOfRank(rank)}));
     worst = std::max(worst, test::CheckJacobians(*rate, {&manifold, nullptr}, {pose.data(), vel.data()}, 1e-6,
                                                  "raw rate " + what));
   }
@@ -71,7 +66,7 @@ TEST(RawGnssFactorTest, DisplacementIsTheAntennasBetweenTwoPoses) {
   double worst = 0.0;
   for (int trial = 0; trial < 6; ++trial) {
     const int rank = 1 + trial % 3;
-    const Mat3 S = SqrtInfoOfRank(rank);
+    const Mat3 S = test::SqrtInfoOfRank(rank);
     const test::PoseBlock pose_i = test::RandomPose(rng), pose_j = test::RandomPose(rng);
     const Vec3 d_w = (PosePosition(pose_j.data()) + Quat(PoseRotation(pose_j.data())) * lever_b) -
                      (PosePosition(pose_i.data()) + Quat(PoseRotation(pose_i.data())) * lever_b);

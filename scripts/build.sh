@@ -11,7 +11,11 @@ while [ $# -ge 2 ] && [ "$1" = "--target" ]; do
   targets+=(--target "$2")
   shift 2
 done
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+# Ninja where the build folder is new (it starts a library's objects before the libraries below it are
+# linked: fewer idle cores); a folder configured before keeps its generator.
+generator=()
+[ -f build/CMakeCache.txt ] || ! command -v ninja >/dev/null || generator=(-G Ninja)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${generator[@]}" "$@" >/dev/null
 python=0
 grep -q '^GINS_BUILD_PYTHON:BOOL=ON' build/CMakeCache.txt && python=1
 if [ ${#targets[@]} -gt 0 ] && [ $python = 1 ]; then targets+=(--target gins_python); fi

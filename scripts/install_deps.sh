@@ -13,7 +13,7 @@ for a in "$@"; do
   fi
 done
 packages=("${extra[@]}"
-  build-essential cmake pkg-config
+  build-essential cmake ninja-build pkg-config
   libeigen3-dev libceres-dev libsuitesparse-dev libgoogle-glog-dev libyaml-cpp-dev
   libgeographiclib-dev libcli11-dev nlohmann-json3-dev zlib1g-dev
   libgtest-dev libgmock-dev

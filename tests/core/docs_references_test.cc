@@ -94,6 +94,8 @@ std::string CheckPath(std::string s) {
   if (s.rfind("./", 0) == 0) s = s.substr(2);
   if (s.rfind("../", 0) == 0 || s.rfind("/", 0) == 0) return "names a file outside the repository";
   const std::string first = s.substr(0, s.find('/'));
+  // The outputs' folders (.gitignore's out*/ and build*/) may exist in a working tree, not in the repository.
+  if (first.rfind("out", 0) == 0 || first.rfind("build", 0) == 0) return {};
   if (!fs::exists(kSourceDir / first)) return {};
   const fs::path p = kSourceDir / s;
   if (EndsWith(s, "/")) return fs::is_directory(p) ? "" : "no such directory in the repository";

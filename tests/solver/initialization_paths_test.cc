@@ -180,14 +180,31 @@ void ExpectOutputFromTheFirstFix(const SimOptions& sim, const Options& options, 
   }
 }
 
-TEST(InitializationPaths, AtRestWithoutHeadingEveryOutputFromTheFirstFix) {
+// One drive per test: three in one took over a minute under the sanitizers.
+SimOptions AtRestWithoutHeading() {
   SimOptions sim = test::TestDrive(31);
   sim.heading_invalid_fraction = 1.0;
+  return sim;
+}
+
+Options WithoutHeading(const SimOptions& sim) {
   Options options = test::TestRunOptions(sim);
   options.sensors.gnss.use_heading = false;
-  ExpectOutputFromTheFirstFix(sim, options, "rest, wheels, no heading");
-  // A gross outlier among the standstill's fixes (20 m north at 8 s) is not in its position.
-  ExpectOutputFromTheFirstFix(sim, options, "rest, wheels, no heading, an outlier", sim.start_time + 8.0);
+  return options;
+}
+
+TEST(InitializationPaths, AtRestWithoutHeadingEveryOutputFromTheFirstFix) {
+  const SimOptions sim = AtRestWithoutHeading();
+  ExpectOutputFromTheFirstFix(sim, WithoutHeading(sim), "rest, wheels, no heading");
+}
+
+TEST(InitializationPaths, AtRestAnOutlierAmongTheStandstillsFixesIsNotInItsPosition) {
+  // A gross outlier among the standstill's fixes (20 m north at 8 s).
+  const SimOptions sim = AtRestWithoutHeading();
+  ExpectOutputFromTheFirstFix(sim, WithoutHeading(sim), "rest, wheels, no heading, an outlier", sim.start_time + 8.0);
+}
+
+TEST(InitializationPaths, AtRestOnSinglePointFixesWithoutWheelsEveryOutputFromTheFirstFix) {
   const SimOptions spp = SppDrive(32, 5.0);
   ExpectOutputFromTheFirstFix(spp, SppOptions(spp), "rest, no wheels, SPP 5 Hz");
 }

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 
 namespace gins {
 namespace {
@@ -43,7 +45,13 @@ double RegularizedGammaP(double a, double x) {
 double Chi2Cdf(double x, int dof) { return RegularizedGammaP(0.5 * dof, 0.5 * x); }
 
 double Chi2Gate(double probability, int dof) {
-  return probability > 0.0 ? Chi2Quantile(probability, dof) : std::numeric_limits<double>::infinity();
+  if (!(probability > 0.0)) return std::numeric_limits<double>::infinity();
+  // Each update asks again with the same few (probability, dof); the quantile's bisection costs ~10 µs, a
+  // raw GNSS epoch asks several times. Per thread: the estimators may run on their own.
+  thread_local std::map<std::pair<double, int>, double> known;
+  const auto [it, added] = known.try_emplace({probability, dof}, 0.0);
+  if (added) it->second = Chi2Quantile(probability, dof);
+  return it->second;
 }
 
 double Chi2Quantile(double p, int dof) {

@@ -1,6 +1,7 @@
 // Broadcast-ephemeris satellite models (core/gnss_orbit.h).
 #include "core/gnss_orbit.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -200,18 +201,55 @@ Vec3 EarthRotationCorrection(const Vec3& r_ecef, double omega_e_rad_s, double tr
   return Vec3(c * r_ecef.x() + s * r_ecef.y(), -s * r_ecef.x() + c * r_ecef.y(), r_ecef.z());
 }
 
-TransmitState SatelliteAtTransmit(const KeplerEphemeris& eph, double rx_gps_s, double pseudorange_m,
-                                  const Vec3& receiver_ecef_m) {
-  const double omega_e = OrbitConstants(eph.sat.system).omega_e_rad_s;
-  TransmitState out;
+namespace {
+
+// The satellite at its transmit time, before the Earth's rotation: it does not depend on the receiver, and
+// every iteration of an epoch's single-point solution and each estimator ask for the same one. Remembered
+// per thread (the estimators may run on their own), the last kKnown asked for; a hit must match the record
+// (its address and its identifying values) and the observation exactly, so it is the same computation.
+struct AtTransmitTime {
+  const KeplerEphemeris* eph = nullptr;
+  SatelliteId sat;
+  double toe_s = 0.0, toc_gps_s = 0.0, af0_s = 0.0, m0_rad = 0.0, rx_gps_s = 0.0, pseudorange_m = 0.0;
+  SatelliteState state;
+  double tx_gps_s = 0.0;
+  bool Is(const KeplerEphemeris& e, double rx, double pr) const {
+    return eph == &e && sat == e.sat && toe_s == e.toe_s && toc_gps_s == e.toc_gps_s && af0_s == e.af0_s &&
+           m0_rad == e.m0_rad && rx_gps_s == rx && pseudorange_m == pr;
+  }
+};
+
+const AtTransmitTime& SatelliteAtTransmitTime(const KeplerEphemeris& eph, double rx_gps_s, double pseudorange_m) {
+  constexpr size_t kKnown = 128;  // two epochs of 64 signals
+  thread_local std::array<AtTransmitTime, kKnown> known;
+  thread_local size_t next = 0;
+  for (const AtTransmitTime& k : known) {
+    if (k.Is(eph, rx_gps_s, pseudorange_m)) return k;
+  }
+  AtTransmitTime& out = known[next];
+  next = (next + 1) % kKnown;
+  out = AtTransmitTime{&eph, eph.sat, eph.toe_s, eph.toc_gps_s, eph.af0_s, eph.m0_rad, rx_gps_s, pseudorange_m, {}, 0.0};
   // Transmit time by the satellite's clock first, then corrected by it: Δt_sv changes by < 1e-11 s per
   // iteration after two (its drift is < 1e-9).
   double tx = rx_gps_s - pseudorange_m / kSpeedOfLight;
   for (int i = 0; i < 3; ++i) {
-    out.sat = KeplerSatelliteState(eph, tx);
-    tx = rx_gps_s - pseudorange_m / kSpeedOfLight - out.sat.clock_bias_s;
+    out.state = KeplerSatelliteState(eph, tx);
+    tx = rx_gps_s - pseudorange_m / kSpeedOfLight - out.state.clock_bias_s;
   }
-  out.sat = KeplerSatelliteState(eph, tx);
+  out.state = KeplerSatelliteState(eph, tx);
+  out.tx_gps_s = tx;
+  return out;
+}
+
+}  // namespace
+
+TransmitState SatelliteAtTransmit(const KeplerEphemeris& eph, double rx_gps_s, double pseudorange_m,
+                                  const Vec3& receiver_ecef_m) {
+  const double omega_e = OrbitConstants(eph.sat.system).omega_e_rad_s;
+  TransmitState out;
+  const AtTransmitTime& at = SatelliteAtTransmitTime(eph, rx_gps_s, pseudorange_m);
+  out.sat = at.state;
+  const double tx = at.tx_gps_s;
   out.tx_gps_s = tx;
   const Vec3 p_tx = out.sat.position_ecef_m, v_tx = out.sat.velocity_ecef_m_s;
   double tau = rx_gps_s - tx;

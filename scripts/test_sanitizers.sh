@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The test suite under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/, -O1 -g1; UBSan on the
 # library and app code, not the tests' own: CMakeLists.txt), all but the drives labelled `long`
-# (tests/long_tests.cmake: minutes each under the sanitizers; their code runs there through the shorter drives). Any sanitizer report fails the run. CI runs it after scripts/test.sh.
+# (tests/long_tests.cmake: minutes each under the sanitizers; their code runs there through the shorter
+# drives). Any sanitizer report fails the run. CI runs it after scripts/test.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install_deps.sh --test

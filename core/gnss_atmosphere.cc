@@ -15,10 +15,20 @@ GeodeticRad EcefToGeodeticRad(const Vec3& ecef_m) {
   return g;
 }
 
+ReceiverSite::ReceiverSite(const Vec3& ecef) : ecef_m(ecef), geo(EcefToGeodeticRad(ecef)) {
+  sin_lat = std::sin(geo.lat);
+  cos_lat = std::cos(geo.lat);
+  sin_lon = std::sin(geo.lon);
+  cos_lon = std::cos(geo.lon);
+}
+
 AzEl SatelliteAzEl(const Vec3& rx_ecef_m, const Vec3& sat_ecef_m, Vec3* los) {
-  const GeodeticRad g = EcefToGeodeticRad(rx_ecef_m);
-  const Vec3 d = (sat_ecef_m - rx_ecef_m).normalized();
-  const double sp = std::sin(g.lat), cp = std::cos(g.lat), sl = std::sin(g.lon), cl = std::cos(g.lon);
+  return SatelliteAzEl(ReceiverSite(rx_ecef_m), sat_ecef_m, los);
+}
+
+AzEl SatelliteAzEl(const ReceiverSite& rx, const Vec3& sat_ecef_m, Vec3* los) {
+  const Vec3 d = (sat_ecef_m - rx.ecef_m).normalized();
+  const double sp = rx.sin_lat, cp = rx.cos_lat, sl = rx.sin_lon, cl = rx.cos_lon;
   const double east = -sl * d.x() + cl * d.y();
   const double north = -sp * cl * d.x() - sp * sl * d.y() + cp * d.z();
   const double up = cp * cl * d.x() + cp * sl * d.y() + sp * d.z();

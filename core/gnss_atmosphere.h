@@ -23,6 +23,16 @@ struct AzEl {
 };
 AzEl SatelliteAzEl(const Vec3& rx_ecef_m, const Vec3& sat_ecef_m, Vec3* los = nullptr);
 
+// A receiver's ECEF position with its geodetic coordinates and the sines and cosines of its latitude and
+// longitude (its ENU axes): worked out once per position, for every satellite seen from there.
+struct ReceiverSite {
+  explicit ReceiverSite(const Vec3& ecef_m);
+  Vec3 ecef_m;
+  GeodeticRad geo;
+  double sin_lat, cos_lat, sin_lon, cos_lon;
+};
+AzEl SatelliteAzEl(const ReceiverSite& rx, const Vec3& sat_ecef_m, Vec3* los = nullptr);
+
 // A standard atmosphere at height h (m, clamped to ≥ 0): pressure 1013.25·(1 − 2.2557e-5·h)^5.2568 hPa,
 // temperature 15 °C − 6.5e-3·h, water vapour pressure from the relative humidity (Magnus-type formula,
 // e = 6.108·rh·exp((17.15·T − 4684)/(T − 38.45)) hPa, T in K) — RTKLIB tropmodel's, for comparability.

@@ -16,13 +16,14 @@ std::vector<RawSatellite> PrepareSatellites(const RawGnssMeasurement& m, const V
   out.reserve(m.satellites.size());
   size_t left_out = 0;
   const RawGnssNav& nav = *m.nav;
+  const ReceiverSite site(r_rx_ecef);
   for (const RawGnssObservation& o : m.satellites) {
     const KeplerEphemeris* eph = SelectEphemeris(nav.ephemerides, o.code.sat, m.rx_gps_s, nav.spp.selection);
     if (eph == nullptr) {
       ++left_out;
       continue;
     }
-    const PseudorangePrediction p = PredictPseudorange(*eph, o.code, m.rx_gps_s, r_rx_ecef, 0.0, nav.spp);
+    const PseudorangePrediction p = PredictPseudorange(*eph, o.code, m.rx_gps_s, site, 0.0, nav.spp);
     if (!(p.azel.el >= nav.spp.elevation_mask_rad) || !std::isfinite(p.corrected_m)) {
       ++left_out;
       continue;

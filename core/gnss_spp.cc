@@ -28,6 +28,12 @@ double EphemerisSigma(const KeplerEphemeris& eph) {
 
 PseudorangePrediction PredictPseudorange(const KeplerEphemeris& eph, const SppObservation& obs, double rx_gps_s,
                                          const Vec3& rx_ecef_m, double rx_clock_m, const SppOptions& options) {
+  return PredictPseudorange(eph, obs, rx_gps_s, ReceiverSite(rx_ecef_m), rx_clock_m, options);
+}
+
+PseudorangePrediction PredictPseudorange(const KeplerEphemeris& eph, const SppObservation& obs, double rx_gps_s,
+                                         const ReceiverSite& rx, double rx_clock_m, const SppOptions& options) {
+  const Vec3& rx_ecef_m = rx.ecef_m;
   PseudorangePrediction p;
   bool known1 = true, known2 = true;
   const double c = kSpeedOfLight;
@@ -48,8 +54,8 @@ PseudorangePrediction PredictPseudorange(const KeplerEphemeris& eph, const SppOb
   p.d_position = -d / range;
   double var = 0.0;
   if (rx_ecef_m.norm() > kOnEarth) {
-    p.azel = SatelliteAzEl(rx_ecef_m, tx.sat.position_ecef_m);
-    const GeodeticRad g = EcefToGeodeticRad(rx_ecef_m);
+    p.azel = SatelliteAzEl(rx, tx.sat.position_ecef_m);
+    const GeodeticRad& g = rx.geo;
     const double sin_el = std::sin(p.azel.el);
     if (options.troposphere) {
       p.troposphere_m = SaastamoinenSlant(g.lat, g.h, p.azel.el);
@@ -96,11 +102,12 @@ SppSolution SolveSpp(double rx_gps_s, const std::vector<SppObservation>& observa
     // Column of each system's clock, over the systems that have a satellite in use.
     std::map<GnssSystem, int> column;
     std::vector<int> rows;
+    const ReceiverSite site(r);
     for (size_t i = 0; i < observations.size(); ++i) {
       use[i] = false;
       if (!ephs[i]) continue;
       const GnssSystem sys = observations[i].sat.system;
-      pred[i] = PredictPseudorange(*ephs[i], observations[i], rx_gps_s, r, sol.clock_m[sys], options);
+      pred[i] = PredictPseudorange(*ephs[i], observations[i], rx_gps_s, site, sol.clock_m[sys], options);
       if (r.norm() > kOnEarth && pred[i].azel.el < options.elevation_mask_rad) continue;
       use[i] = true;
       rows.push_back(static_cast<int>(i));
@@ -143,6 +150,7 @@ SppSolution SolveSpp(double rx_gps_s, const std::vector<SppObservation>& observa
     it = any ? std::next(it) : sol.clock_m.erase(it);
   }
   sol.position_ecef_m = r;
+  const ReceiverSite site(r);
   for (size_t i = 0; i < observations.size(); ++i) {
     SppSatellite s;
     s.sat = observations[i].sat;
@@ -151,7 +159,7 @@ SppSolution SolveSpp(double rx_gps_s, const std::vector<SppObservation>& observa
       s.rejected = "no ephemeris";
     } else {
       const auto clock = sol.clock_m.find(s.sat.system);
-      const PseudorangePrediction p = PredictPseudorange(*ephs[i], observations[i], rx_gps_s, r,
+      const PseudorangePrediction p = PredictPseudorange(*ephs[i], observations[i], rx_gps_s, site,
                                                          clock == sol.clock_m.end() ? 0.0 : clock->second, options);
       s.azel = p.azel;
       s.residual_m = p.corrected_m - p.predicted_m;

@@ -86,6 +86,8 @@ struct PseudorangePrediction {
 // Atmosphere and elevation are evaluated only when `rx_ecef_m` is on the Earth (|r| > 6000 km).
 PseudorangePrediction PredictPseudorange(const KeplerEphemeris& eph, const SppObservation& obs, double rx_gps_s,
                                          const Vec3& rx_ecef_m, double rx_clock_m, const SppOptions& options);
+PseudorangePrediction PredictPseudorange(const KeplerEphemeris& eph, const SppObservation& obs, double rx_gps_s,
+                                         const ReceiverSite& rx, double rx_clock_m, const SppOptions& options);
 
 // The fix of one epoch (`rx_gps_s`: the receiver's time tag, GPS seconds). `initial_ecef_m` may be zero
 // (the Earth's centre: converges in ~6 iterations). Needs 3 + (systems) satellites above the mask.

@@ -681,6 +681,7 @@ TEST(ConfigLoaderTest, RoundTripIsExact) {
       {"non-default", NonDefaultOptions()},
       {"wvu_rover.yaml", LoadOptions(kConfigDir + "wvu_rover.yaml")},
       {"sim_sample.yaml", LoadOptions(kConfigDir + "sim_sample.yaml")},
+      {"rtkx_walk_raw.yaml", LoadOptions(kConfigDir + "rtkx_walk_raw.yaml")},
   };
   for (const auto& [name, o] : cases) {
     SCOPED_TRACE(name);

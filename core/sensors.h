@@ -54,10 +54,11 @@ struct GnssOptions {
   Vec3 sigma_enu = Vec3(0.05, 0.05, 0.10);  // gnss.sigma_m [e, n, u]: used when a fix carries no σ
   double min_sigma = 0.005;                // gnss.min_sigma_m: floor for logged σ (a zero σ is not trusted)
   // gnss.time_offset_s: the GNSS records (fixes, headings, velocities) are stamped this much after the IMU
-  // time at which they were measured (a receiver's latency into the logger). A number: gins takes t − offset.
-  // `estimate` (estimate_time_offset): the ESKF (solver/eskf.h) and the smoothers (a keyframe block,
-  // solver/keyframe.h) estimate the rest as a state, from 0 with 1-σ time_offset_sigma and a random walk
-  // time_offset_rw.
+  // time at which they were measured (a receiver's latency into the logger). A number: gins takes t − offset,
+  // and a raw epoch's GPS time less it (the log's clock behind GPS time). `estimate` (estimate_time_offset):
+  // the ESKF (solver/eskf.h) and the smoothers (a keyframe block, solver/keyframe.h) estimate the rest as a
+  // state, from 0 with 1-σ time_offset_sigma and a random walk time_offset_rw (from the records; raw epochs
+  // hold it at 0).
   double time_offset = 0.0;
   bool estimate_time_offset = true;
   double time_offset_sigma = 0.1;  // gnss.time_offset_sigma_s

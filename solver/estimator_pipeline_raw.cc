@@ -1,4 +1,5 @@
 // The estimator pipeline's raw GNSS epochs (solver/estimator_pipeline.h, solver/raw_gnss_feed.h).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -44,12 +45,13 @@ void EstimatorPipeline::SetRawGnssFeed(std::unique_ptr<RawGnssFeed> feed) { raw_
 
 void EstimatorPipeline::DrainRawFeed(double t) {
   draining_raw_ = true;
-  // Epochs are tagged on the receiver's clock: each is read up to kClockLookAhead early, dated on GPS time
-  // by its fix's clock, and used once the records reach that time, so it takes its place in time order.
+  // Epochs are tagged on the receiver's clock: each is read up to kClockLookAhead early (and a stated GNSS
+  // time offset more), dated on GPS time by its fix's clock and then on the IMU's clock by that offset, and
+  // used once the records reach that time, so it takes its place in time order.
   RawGnssMeasurement m;
-  while (raw_feed_->NextBefore(t + kClockLookAhead, &m)) {
+  while (raw_feed_->NextBefore(t + kClockLookAhead + std::max(sensors_.gnss.time_offset, 0.0), &m)) {
     const double first = first_t_ >= 0.0 ? first_t_ : t;  // before the first record: the one coming
-    if (m.rx_gps_s < first - kBeforeLog) {
+    if (m.rx_gps_s - sensors_.gnss.time_offset < first - kBeforeLog) {
       ++raw_.before_log;
       continue;
     }
@@ -99,8 +101,10 @@ EstimatorPipeline::PreparedRawGnss EstimatorPipeline::PrepareRawGnss(RawGnssMeas
     const auto gps = p.sol.clock_m.find(GnssSystem::kGps);
     last_clock_m_ = gps != p.sol.clock_m.end() ? gps->second : p.sol.clock_m.begin()->second;
   }
-  // Without a fix, the last one's clock (a receiver clock drifts by microseconds per second).
-  m.t = m.rx_gps_s - last_clock_m_.value_or(0.0) / kSpeedOfLight;
+  // Without a fix, the last one's clock (a receiver clock drifts by microseconds per second). GPS time is
+  // then put on the IMU's clock as for every GNSS record: gnss.time_offset_s says how much later than the
+  // IMU time of their measurement the GNSS times are (the estimated part of it is not applied to raw epochs).
+  m.t = m.rx_gps_s - last_clock_m_.value_or(0.0) / kSpeedOfLight - sensors_.gnss.time_offset;
   p.m = std::move(m);
   return p;
 }

@@ -6,9 +6,9 @@ usage: filtering_optimum.py --config C --log LOG --truth TRUTH --run DIR [--obs 
 
 For every N-th truth epoch t_k, the batch smoother (`gins run --mode batch`) is run on the log (and the RINEX
 observations) cut at t_k, and its state at t_k is kept: the estimate given every measurement up to t_k,
-which is what a causal output at t_k can at best be with the same models. An epoch where that run cannot
-initialise (too little motion before t_k) has no such estimate and is counted apart. The horizontal RMSE of
-these estimates is printed beside that of each output of the full run in DIR (`gins run --mode all`), on
+which a causal output at t_k with the same models can at best match on average (on a few epochs one may
+be closer by chance). An epoch where that run cannot initialise (too little motion before t_k) has no such
+estimate and is counted apart. The horizontal RMSE of these estimates is printed beside that of each output of the full run in DIR (`gins run --mode all`), on
 the same epochs: a causal output (eskf, smoother) near the optimum has nothing left to gain from these
 measurements, only from more of them or from the future (eskf_rts, batch). --remove-offset removes one
 constant horizontal offset per output (a reference in another frame, as the RTK track of rtkx_walk_raw).

@@ -28,7 +28,7 @@ std::vector<RawSatellite> PrepareSatellites(const RawGnssMeasurement& m, const V
       ++left_out;
       continue;
     }
-    const TransmitState tx = SatelliteAtTransmit(*eph, m.rx_gps_s, o.code.pseudorange_m, r_rx_ecef);
+    const TransmitState& tx = p.tx;
     RawSatellite s;
     s.sat = o.code.sat;
     s.r_sat_ecef = tx.sat.position_ecef_m;

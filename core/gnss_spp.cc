@@ -48,7 +48,8 @@ PseudorangePrediction PredictPseudorange(const KeplerEphemeris& eph, const SppOb
   }
   p.group_delay_known = known1 && known2;
 
-  const TransmitState tx = SatelliteAtTransmit(eph, rx_gps_s, obs.pseudorange_m, rx_ecef_m);
+  p.tx = SatelliteAtTransmit(eph, rx_gps_s, obs.pseudorange_m, rx_ecef_m);
+  const TransmitState& tx = p.tx;
   const Vec3 d = tx.sat.position_ecef_m - rx_ecef_m;
   const double range = d.norm();
   p.d_position = -d / range;

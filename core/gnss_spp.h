@@ -82,6 +82,7 @@ struct PseudorangePrediction {
   AzEl azel;
   double ionosphere_m = 0.0, troposphere_m = 0.0;
   bool group_delay_known = true;
+  TransmitState tx;  // the satellite at its transmit time (SatelliteAtTransmit), in the ECEF of reception
 };
 // Atmosphere and elevation are evaluated only when `rx_ecef_m` is on the Earth (|r| > 6000 km).
 PseudorangePrediction PredictPseudorange(const KeplerEphemeris& eph, const SppObservation& obs, double rx_gps_s,

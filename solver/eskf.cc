@@ -37,6 +37,7 @@ Eskf::Eskf(const SensorOptions& sensors, const EskfOptions& eskf, const Standsti
       watchdog_options_(watchdog),
       on_state_(std::move(on_state)),
       on_rts_(std::move(on_rts)),
+      gnss_consistency_(sensors.gnss.gate_probability, 3),
       watchdog_(watchdog) {
   gate_gnss_ = Chi2Gate(sensors_.gnss.gate_probability, 3);
   gate_heading_ = Chi2Gate(sensors_.gnss.gate_probability, 1);
@@ -414,6 +415,7 @@ nlohmann::json Eskf::Stats() const {
   j["wheel_yaw_rate"] = wheel_yaw_counts_.ToJson();
   j["nonholonomic"] = nhc_counts_.ToJson();
   j["gnss_reacquired"] = gnss_inflation_.reacquired();
+  j["gnss_gate_scale"] = {{"final", gnss_consistency_.scale()}, {"max", gnss_consistency_.max_scale()}};
   j["zero_velocity"] = zupt_counts_.ToJson();
   j["final_odom_scale"] = nom_.Scalar<Block::kS>();
   // The GNSS time offset: the stated value plus the estimated part (gnss.time_offset_s).

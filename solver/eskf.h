@@ -14,6 +14,8 @@
 // non-holonomic constraint at vehicle.nhc_rate_hz whether or not the log has wheels, standstill updates. A
 // run of rejected GNSS fixes that agree with one another inflates the gate and, when a fix is accepted under
 // it, the covariance it updates (GateInflation, solver/estimator_common.h): re-acquisition after an outage by design.
+// Fixes that disagree with the prediction by more than stated on most fixes scale the position gate
+// (GateConsistency, the same file).
 //
 // Standstills, IMU gaps and the watchdog behave as docs/robustness.md ("Field robustness") describes, in
 // both estimators alike (solver/estimator_common.h). Here: the zero-rate update takes the mean gyro reading
@@ -171,6 +173,7 @@ class Eskf : public Estimator {
   int wheel_gyro_count_ = 0;
   double last_nhc_t_ = -1e300;
   GateInflation gnss_inflation_;
+  GateConsistency gnss_consistency_;
 
   // χ² gates, computed once (the quantile is an iterative inversion).
   double gate_gnss_ = 0.0, gate_heading_ = 0.0, gate_wheel_ = 0.0, gate_nhc_ = 0.0, gate_wheel_yaw_ = 0.0,

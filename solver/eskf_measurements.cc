@@ -83,14 +83,19 @@ bool Eskf::UpdateGnssPosition(const GnssMeasurement& m) {
   };
   const Mat3 R = m.sigma_w.cwiseAbs2().asDiagonal();
   const double inflation = gnss_inflation_.factor();
+  const double gate = gate_gnss_ * gnss_consistency_.scale();
   Vec3 innovation;
   Mat3 S;
-  const bool accepted = Update<3>(model, R, gate_gnss_, &gnss_counts_, m.t, inflation, &innovation, &S);
+  const bool accepted = Update<3>(model, R, gate, &gnss_counts_, m.t, inflation, &innovation, &S);
   if (accepted) {
-    if (inflation > 1.0) gnss_inflation_.CountReacquired();
+    if (inflation > 1.0) {
+      gnss_inflation_.CountReacquired();
+    } else {
+      gnss_consistency_.Add(innovation.dot(S.ldlt().solve(innovation)));
+    }
     gnss_inflation_.Accepted();
   } else {
-    gnss_inflation_.Rejected(m.t, innovation, S, gate_gnss_);
+    gnss_inflation_.Rejected(m.t, innovation, S, gate);
   }
   return accepted;
 }

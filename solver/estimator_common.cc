@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/chi2.h"
 #include "core/so3.h"
 #include "solver/summary_keys.h"
 
@@ -184,6 +185,44 @@ void GateInflation::Rejected(double t, const Vec3& innovation, const Mat3& S, do
   factor_ = std::exp2(std::min(t - start_, 60.0));
   last_innovation_ = innovation;
   last_S_ = S;
+}
+
+GateConsistency::GateConsistency(double gate_probability, int dof) {
+  median_ = Chi2Quantile(0.5, dof);
+  bounds_.fill(HUGE_VAL);
+  if (!(gate_probability > 0.0)) return;  // no gate: nothing to scale
+  for (int n = kMinFixes; n <= kFixes; ++n) {
+    // The sample median (the (n/2+1)-th smallest) of n χ² exceeds q when at least n − n/2 of them do:
+    // a binomial tail in u = P(χ² > q), which grows with u. u is found where the tail is
+    // 1 − gate_probability, by bisection.
+    const auto tail = [n](double u) {
+      double sum = 0.0;
+      for (int k = n - n / 2; k <= n; ++k) {
+        sum += std::exp(std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0) + k * std::log(u) +
+                        (n - k) * std::log1p(-u));
+      }
+      return sum;
+    };
+    double lo = 0.0, hi = 0.5;
+    for (int i = 0; i < 60; ++i) {
+      const double u = 0.5 * (lo + hi);
+      (tail(u) > 1.0 - gate_probability ? hi : lo) = u;
+    }
+    bounds_[n] = Chi2Quantile(1.0 - 0.5 * (lo + hi), dof);
+  }
+}
+
+void GateConsistency::Add(double chi2) {
+  if (!std::isfinite(chi2)) return;
+  recent_[next_] = chi2;
+  next_ = (next_ + 1) % kFixes;
+  count_ = std::min(count_ + 1, kFixes);
+  if (count_ < kMinFixes) return;
+  std::array<double, kFixes> sorted = recent_;
+  const auto mid = sorted.begin() + count_ / 2;
+  std::nth_element(sorted.begin(), mid, sorted.begin() + count_);
+  scale_ = *mid > bounds_[count_] ? *mid / median_ : 1.0;
+  max_scale_ = std::max(max_scale_, scale_);
 }
 
 void ImuGapLog::Add(double last_sample, double next_sample) {

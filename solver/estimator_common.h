@@ -3,6 +3,7 @@
 // a fix, the summary's time offset.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -83,6 +84,34 @@ class GateInflation {
   Mat3 last_S_ = Mat3::Identity();
   double factor_ = 1.0;
   uint64_t reacquired_ = 0;
+};
+
+// The GNSS position gate's scale, learnt from the fixes it accepts. A receiver's stated σ is its precision,
+// and an IMU's stated noise its noise at rest: on a hand-held unit or a vibrating mount the fixes and the
+// prediction may disagree by several times what their covariances say on every fix, not on a few. Gated
+// at the stated covariances, half the good fixes are then rejected and each rejection lets the estimate
+// drift until the next is rejected too. Over the last kFixes accepted fixes (from kMinFixes on), the
+// median of their χ² (with the predicted covariance undoubted) is compared with χ²(dof)'s median: when it
+// is above what consistent fixes give with probability 1 − gnss.gate_probability, the gate's bound is
+// multiplied by the ratio of the two medians (the innovations' spread against the stated one), else by 1.
+// The median ignores the odd outlier that passes; a burst of outliers passes no gate and teaches nothing.
+// The update keeps the stated noise: only which fixes are outliers changes.
+class GateConsistency {
+ public:
+  GateConsistency(double gate_probability, int dof);
+  // A fix accepted at the unscaled, undoubted gate's χ² = chi2.
+  void Add(double chi2);
+  double scale() const { return scale_; }
+  double max_scale() const { return max_scale_; }
+
+ private:
+  static constexpr int kFixes = 21, kMinFixes = 5;
+  std::array<double, kFixes> recent_{};
+  int count_ = 0, next_ = 0;
+  double median_ = 1.0;  // χ²(dof)'s median
+  // The sample median's bound for n consistent fixes, by n (+∞ below kMinFixes, or without a gate).
+  std::array<double, kFixes + 1> bounds_{};
+  double scale_ = 1.0, max_scale_ = 1.0;
 };
 
 // IMU gaps longer than imu.max_gap_s, counted and the first few listed (summary: imu_gaps, imu_gap_times).

@@ -131,7 +131,19 @@ GnssAttacher::GnssAttacher(const GnssOptions& gnss, std::function<void(double, b
       gate_heading_(Chi2Gate(gnss.gate_probability, 1)),
       // A gate of +∞ (probability 0) leaves no corner: then no loss, as the ESKF has none.
       loss_position_(std::isfinite(gate_position_) ? new ceres::HuberLoss(std::sqrt(gate_position_)) : nullptr),
-      loss_heading_(std::isfinite(gate_heading_) ? new ceres::HuberLoss(std::sqrt(gate_heading_)) : nullptr) {}
+      loss_heading_(std::isfinite(gate_heading_) ? new ceres::HuberLoss(std::sqrt(gate_heading_)) : nullptr),
+      consistency_(gnss.gate_probability, 3) {}
+
+// The loss of a position factor accepted under the gate scaled by `scale`: a Huber loss whose corner is that
+// gate, so every residual it accepts is inside the quadratic part as at scale 1. One per scale in steps of
+// 2^(1/8) (the window's factors keep theirs).
+ceres::LossFunction* GnssAttacher::PositionLoss(double scale) {
+  if (!(scale > 1.0) || loss_position_ == nullptr) return loss_position_.get();
+  const int step = static_cast<int>(std::ceil(8.0 * std::log2(scale)));
+  std::unique_ptr<ceres::LossFunction>& loss = scaled_losses_[step];
+  if (loss == nullptr) loss.reset(new ceres::HuberLoss(std::sqrt(gate_position_ * std::exp2(step / 8.0))));
+  return loss.get();
+}
 
 bool GnssAttacher::On(const GnssMeasurement& m, const AttachContext& ctx) {
   const Prediction pred = ctx.predict(m.t);
@@ -162,21 +174,23 @@ bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pr
           ? DelayedCheck(GnssAtTime{m.p_w, m.sigma_w.cwiseInverse(), gnss_.lever_b}, pred, at, ctx)
           : StampCheck(GnssFactor::Create(m.p_w, m.sigma_w, gnss_.lever_b), at, false, pred, ctx);
   const double inflation = inflation_.factor();
+  const double scale = consistency_.scale();
+  const double bound = gate_position_ * scale;
   const FactorCheck plain = gate.Run();
   const FactorCheck check = inflation > 1.0 ? gate.Run(inflation) : plain;
-  if (!check.Passes(gate_position_)) {
+  if (!check.Passes(bound)) {
     position_counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
     if (ctx.keyframes.log() != nullptr && check.evaluated) {
       const Anchor a = ctx.partial(m.t);
       std::vector<BlockRef> blocks;
       ceres::CostFunction* cost = PositionFactor(m, pred, a, ctx, &blocks);
-      ctx.keyframes.LogRejected(cost, loss_position_.get(), blocks, gate_position_);
+      ctx.keyframes.LogRejected(cost, PositionLoss(scale), blocks, bound);
     }
     if (plain.evaluated) {
       Vec3 innovation;
       Mat3 S;
       Unwhiten(plain, m.sigma_w, &innovation, &S);
-      inflation_.Rejected(m.t, innovation, S, gate_position_);
+      inflation_.Rejected(m.t, innovation, S, bound);
     }
     on_checked_(m.t, false);
     return false;
@@ -184,6 +198,8 @@ bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pr
   if (inflation > 1.0) {
     inflation_.CountReacquired();
     on_reacquired_(inflation);
+  } else {
+    consistency_.Add(plain.chi2);
   }
   inflation_.Accepted();
   const Anchor a = ctx.anchor(m.t);
@@ -191,7 +207,7 @@ bool GnssAttacher::AttachPosition(const GnssMeasurement& m, const Prediction& pr
   ceres::CostFunction* cost = PositionFactor(m, pred, a, ctx, &blocks);
   // A fix that passed only the widened gate is far from the window in R's units: under the Huber loss it
   // would pull with the weight of an outlier and the window could not follow it. It passed the gate: no loss.
-  ctx.keyframes.AddMeasurement(cost, inflation > 1.0 ? nullptr : loss_position_.get(), blocks, gate_position_);
+  ctx.keyframes.AddMeasurement(cost, inflation > 1.0 ? nullptr : PositionLoss(scale), blocks, bound);
   ++position_counts_.used;
   on_checked_(m.t, true);
   return true;
@@ -233,6 +249,7 @@ void GnssAttacher::AddStats(nlohmann::json* stats) const {
   (*stats)["gnss_position"] = position_counts_.ToJson();
   (*stats)["gnss_heading"] = heading_counts_.ToJson();
   (*stats)["gnss_reacquired"] = inflation_.reacquired();
+  (*stats)["gnss_gate_scale"] = {{"final", consistency_.scale()}, {"max", consistency_.max_scale()}};
 }
 
 // --- GNSS velocity ----------------------------------------------------------------------------------------

@@ -12,7 +12,9 @@
 //
 // The attachers here:
 // - GnssAttacher: position and dual-antenna heading; a run of rejected fixes that agree with one another
-//   inflates the gate (GateInflation, solver/estimator_common.h), and a fix accepted under it relieves the prior.
+//   inflates the gate (GateInflation, solver/estimator_common.h), and a fix accepted under it relieves the prior;
+//   fixes that disagree with the prediction by more than stated on most fixes scale the gate and its Huber
+//   corner (GateConsistency, the same file).
 // - GnssVelocityAttacher: GNSS (Doppler) velocity.
 // - StandstillAttacher: from the session's detector, a zero-velocity factor on each keyframe inside a
 //   standstill (checked against the predicted velocity, not above standstill.max_speed_m_s), and a
@@ -141,6 +143,7 @@ class GnssAttacher final : public AttacherOf<GnssMeasurement> {
   ceres::CostFunction* PositionFactor(const GnssMeasurement& m, const Prediction& pred, const Anchor& a,
                                       const AttachContext& ctx, std::vector<BlockRef>* blocks) const;
   bool AttachPosition(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
+  ceres::LossFunction* PositionLoss(double scale);
   bool AttachHeading(const GnssMeasurement& m, const Prediction& pred, const AttachContext& ctx);
 
   GnssOptions gnss_;
@@ -149,6 +152,8 @@ class GnssAttacher final : public AttacherOf<GnssMeasurement> {
   double gate_position_, gate_heading_;
   std::unique_ptr<ceres::LossFunction> loss_position_, loss_heading_;
   GateInflation inflation_;
+  GateConsistency consistency_;
+  std::map<int, std::unique_ptr<ceres::LossFunction>> scaled_losses_;  // PositionLoss's, by scale step
   MeasurementCounts position_counts_, heading_counts_;
 };
 

@@ -4,8 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <random>
 
+#include "core/chi2.h"
 #include "core/so3.h"
 
 namespace gins {
@@ -24,6 +28,87 @@ TEST(MeasurementCounts, OfferedIsUsedPlusEveryRejection) {
   EXPECT_EQ(j["offered"].get<uint64_t>(), 10u);
   EXPECT_EQ(j["rejected_times"].size(), 3u);
   EXPECT_EQ(MeasurementCounts().ToJson()["offered"].get<uint64_t>(), 0u);
+}
+
+// χ²(3) draws scaled by `spread` (the innovations' true covariance over the stated one), each accepted only
+// under the consistency's current gate as an estimator does, and added to it.
+int FeedConsistency(GateConsistency* c, double spread, int n, double gate, std::mt19937* rng, int* raised) {
+  std::chi_squared_distribution<double> chi2(3.0);
+  int accepted = 0;
+  for (int i = 0; i < n; ++i) {
+    const double x = spread * chi2(*rng);
+    if (x > gate * c->scale()) continue;
+    c->Add(x);
+    ++accepted;
+    if (c->scale() > 1.0) ++*raised;
+  }
+  return accepted;
+}
+
+// The bound on the sample median: disjoint windows of 21 consistent fixes pass it with the gate's
+// probability (0.99 here, so that 20000 windows measure it to ±7 %).
+TEST(GateConsistency, ConsistentFixesRaiseTheGateAtTheGatesFalseAlarmRate) {
+  std::mt19937 rng(7);
+  const double gate = Chi2Gate(0.99, 3);
+  int raised_windows = 0;
+  const int windows = 20000;
+  const GateConsistency fresh(0.99, 3);
+  for (int w = 0; w < windows; ++w) {
+    GateConsistency c = fresh;
+    std::chi_squared_distribution<double> chi2(3.0);
+    for (int i = 0; i < 21; ++i) c.Add(std::min(chi2(rng), gate));  // the gate truncates
+    raised_windows += c.scale() > 1.0;
+  }
+  const double rate = static_cast<double>(raised_windows) / windows;
+  std::printf("consistent windows raised: %.4f (expected at most 0.01)\n", rate);
+  EXPECT_GT(rate, 0.006);  // a bound far too high would never raise it
+  EXPECT_LT(rate, 0.012);
+}
+
+// At the config's default probability, a long run of consistent fixes leaves the gate alone (the scale is
+// exactly 1, so every output stays as it was), and fewer than 21 fixes never change it.
+TEST(GateConsistency, ConsistentFixesLeaveTheDefaultGateAlone) {
+  std::mt19937 rng(11);
+  GateConsistency c(0.9999, 3);
+  int raised = 0;
+  FeedConsistency(&c, 1.0, 20, Chi2Gate(0.9999, 3), &rng, &raised);
+  EXPECT_EQ(c.scale(), 1.0);
+  FeedConsistency(&c, 1.0, 20000, Chi2Gate(0.9999, 3), &rng, &raised);
+  EXPECT_LE(raised, 20);  // of 20000 (overlapping windows: a false alarm lasts a few fixes)
+  EXPECT_EQ(GateConsistency(0.0, 3).scale(), 1.0);
+}
+
+// Innovations four times the stated σ (χ² 16 times its size): the gate learns a scale near 16 within a few
+// dozen fixes, from the fixes it accepted at the stated gate, and then accepts almost all of them.
+TEST(GateConsistency, InnovationsWiderThanStatedScaleTheGate) {
+  std::mt19937 rng(3);
+  const double gate = Chi2Gate(0.9999, 3);
+  GateConsistency c(0.9999, 3);
+  int raised = 0;
+  FeedConsistency(&c, 16.0, 100, gate, &rng, &raised);
+  EXPECT_GT(c.scale(), 10.0);
+  const int accepted = FeedConsistency(&c, 16.0, 1000, gate, &rng, &raised);
+  std::printf("scale %.1f (max %.1f), accepted %d of 1000\n", c.scale(), c.max_scale(), accepted);
+  EXPECT_GT(c.scale(), 12.0);
+  EXPECT_LT(c.scale(), 21.0);
+  EXPECT_GT(accepted, 980);
+}
+
+// One accepted fix in ten just inside the gate (multipath the gate cannot tell) barely moves the median:
+// the gate is seldom widened for them, and then by little.
+TEST(GateConsistency, NearGateOutliersBarelyWidenTheGate) {
+  std::mt19937 rng(5);
+  std::chi_squared_distribution<double> chi2(3.0);
+  const double gate = Chi2Gate(0.9999, 3);
+  GateConsistency c(0.9999, 3);
+  int raised = 0;
+  for (int i = 0; i < 5000; ++i) {
+    c.Add(i % 10 == 0 ? 0.95 * gate : std::min(chi2(rng), gate));
+    raised += c.scale() > 1.0;
+  }
+  std::printf("raised on %d of 5000 fixes, max scale %.2f\n", raised, c.max_scale());
+  EXPECT_LT(raised, 100);
+  EXPECT_LT(c.max_scale(), 3.0);
 }
 
 // The watchdog's re-initialisation from a fix (ResetPositionFromFix, ResetWaitsForCourse).

@@ -132,7 +132,9 @@ class Eskf : public Estimator {
   void UpdateRawGnss(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats, bool rates);
   // The carrier phases' time differences since the previous epoch; then that epoch becomes this one.
   void UpdateRawPhase(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats);
-  // Watchdog: after a GNSS position update (accepted or not); returns true if it re-initialised.
+  // Watchdog: before a fix is used, true if its verdict took the fix (held for a course, or re-initialised
+  // from it); after a GNSS position update (accepted or not), true if it re-initialised.
+  bool WatchdogTakes(const GnssMeasurement& m);
   bool WatchGnss(const GnssMeasurement& m, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
 

@@ -40,25 +40,29 @@ ShiftedKinematics<T> ShiftedState(const NavState& x, double td, const Vec3& a_w,
 void Eskf::Use(const GnssMeasurement& m) {
   if (!initialized_ || m.t < nom_.x.t) return;
   Propagate(m.t);
-  if (watchdog_options_.enabled) {
-    FlushCovariance();
-    const bool finite = nom_.AllFinite() && P_.allFinite();
-    const double sigma_p = std::sqrt(BlockOf<Block::kP>(P_).diagonal().maxCoeff());
-    const FixVerdict verdict = WatchdogVerdict(m, finite, sigma_p, sensors_, watchdog_options_, nom_.x, P_, &course_wait_, &prev_fix_);
-    if (verdict != FixVerdict::kUse) {
-      if (verdict == FixVerdict::kReset) {
-        ResetFromGnss(m, finite ? "covariance" : "non_finite");
-        prev_fix_ = m;
-      }
-      ++gnss_counts_.used;  // the re-initialisation's fix (or one held for its course): offered stays every fix
-      return;
-    }
+  if (WatchdogTakes(m)) {
+    ++gnss_counts_.used;  // the re-initialisation's fix (or one held for its course): offered stays every fix
+    return;
   }
   const bool accepted = UpdateGnssPosition(m);
   const bool reset = WatchGnss(m, accepted);
   prev_fix_ = m;
   if (reset) return;
   if (m.heading_valid && sensors_.gnss.use_heading) UpdateHeading(m);
+}
+
+bool Eskf::WatchdogTakes(const GnssMeasurement& m) {
+  if (!watchdog_options_.enabled) return false;
+  FlushCovariance();
+  const bool finite = nom_.AllFinite() && P_.allFinite();
+  const double sigma_p = std::sqrt(BlockOf<Block::kP>(P_).diagonal().maxCoeff());
+  const FixVerdict verdict = WatchdogVerdict(m, finite, sigma_p, sensors_, watchdog_options_, nom_.x, P_, &course_wait_, &prev_fix_);
+  if (verdict == FixVerdict::kUse) return false;
+  if (verdict == FixVerdict::kReset) {
+    ResetFromGnss(m, finite ? "covariance" : "non_finite");
+    prev_fix_ = m;
+  }
+  return true;
 }
 
 bool Eskf::UpdateGnssPosition(const GnssMeasurement& m) {

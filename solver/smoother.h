@@ -102,6 +102,12 @@ class Smoother : public Estimator {
   void CountCovarianceFailure(const char* what);
   ceres::ResidualBlockId AddImuFactor(Keyframe& prev, Keyframe& kf);
   void WatchGnss(double t, bool accepted);
+  // The watchdog's verdict before a fix is used: true if it took the fix
+  // (held for a course, or the window rebuilt from it).
+  bool WatchdogTakes(const GnssMeasurement& m);
+  // Attaches the measurement carrying fix, and rebuilds the window from fix if its outcome made the
+  // watchdog fire (WatchGnss).
+  void AttachWatched(const GnssMeasurement& fix, const Measurement& measurement);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);
   // One Ceres solve of the window with the configured options; false if the solution is not usable.
   bool Solve();

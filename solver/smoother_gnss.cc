@@ -21,33 +21,41 @@ namespace gins {
 void Smoother::Use(const GnssMeasurement& m, const Measurement& measurement) {
   if (!initialized_ || m.t < t_now_ - kSameEpoch || m.t < window_.back().t - kSameEpoch) return;
   if (m.t > window_.back().t + kSameEpoch) SolveIfPending();
-  if (watchdog_options_.enabled) {
-    // The σ at the fix, predicted from the newest keyframe, and that of the keyframe that left the window
-    // last (a window behind, it lags a long gap by a window's time).
-    const Prediction p = PredictAt(m.t);
-    const Mat15 P = NavCovariance(window_.EstimatedTypes(), p.cov);
-    const double sigma_p = std::sqrt(P.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
-    const bool finite = window_.back().State().AllFinite() && pred_.AllFinite() && std::isfinite(sigma_p);
-    const FixVerdict verdict =
-        WatchdogVerdict(m, finite, std::max(sigma_p, last_sigma_p_), sensors_, watchdog_options_, p.x, P, &course_wait_, &prev_fix_);
-    if (verdict != FixVerdict::kUse) {
-      if (verdict == FixVerdict::kReset) {
-        ResetFromGnss(m, finite ? "covariance" : "non_finite");
-        prev_fix_ = m;
-      }
-      for (auto& attacher : attachers_) attacher->OnResetFix(m);  // counted as used: offered stays every fix
-      return;
-    }
+  if (WatchdogTakes(m)) {
+    for (auto& attacher : attachers_) attacher->OnResetFix(m);  // counted as used: offered stays every fix
+    return;
   }
+  AttachWatched(m, measurement);
+}
+
+bool Smoother::WatchdogTakes(const GnssMeasurement& m) {
+  if (!watchdog_options_.enabled) return false;
+  // The σ at the fix, predicted from the newest keyframe, and that of the keyframe that left the window
+  // last (a window behind, it lags a long gap by a window's time).
+  const Prediction p = PredictAt(m.t);
+  const Mat15 P = NavCovariance(window_.EstimatedTypes(), p.cov);
+  const double sigma_p = std::sqrt(P.block<3, 3>(nav::kP, nav::kP).diagonal().maxCoeff());
+  const bool finite = window_.back().State().AllFinite() && pred_.AllFinite() && std::isfinite(sigma_p);
+  const FixVerdict verdict =
+      WatchdogVerdict(m, finite, std::max(sigma_p, last_sigma_p_), sensors_, watchdog_options_, p.x, P, &course_wait_, &prev_fix_);
+  if (verdict == FixVerdict::kUse) return false;
+  if (verdict == FixVerdict::kReset) {
+    ResetFromGnss(m, finite ? "covariance" : "non_finite");
+    prev_fix_ = m;
+  }
+  return true;
+}
+
+void Smoother::AttachWatched(const GnssMeasurement& fix, const Measurement& measurement) {
   reset_reason_.clear();
   const std::optional<GnssMeasurement> prev_fix = prev_fix_;
-  prev_fix_ = m;
+  prev_fix_ = fix;
   if (Attach(measurement)) solve_pending_ = true;
   if (!reset_reason_.empty()) {
     prev_fix_ = prev_fix;  // the fix before this one, for the velocity
     SolveIfPending();
-    ResetFromGnss(m, reset_reason_);
-    prev_fix_ = m;
+    ResetFromGnss(fix, reset_reason_);
+    prev_fix_ = fix;
   }
 }
 

@@ -187,6 +187,12 @@ std::vector<int> ScreenSatellites(const NuisanceRows& rows, const MatX& P, doubl
   return keep;
 }
 
+int DifferenceCount(const std::vector<int>& group) {
+  std::vector<int> sorted = group;
+  std::sort(sorted.begin(), sorted.end());
+  return static_cast<int>(sorted.size() - (std::unique(sorted.begin(), sorted.end()) - sorted.begin()));
+}
+
 void DifferenceByGroup(const NuisanceRows& rows, VecX* r_d, MatX* H_d, MatX* R_d, int* groups_used) {
   const int n = static_cast<int>(rows.r.size());
   // The reference of each group: its row of least variance (the first of equals).

@@ -146,10 +146,17 @@ struct NuisanceRows {
 // |w| beyond w_max removed and the rest tested again. Returns the rows kept (indices into rows), in order.
 // A group of one row says nothing (its clock absorbs it) and is kept untested.
 std::vector<int> ScreenSatellites(const NuisanceRows& rows, const MatX& P, double w_max);
+// Whether a screening kept most of what it was offered. Data snooping assumes a few outliers among many:
+// when it removes more satellites than it keeps, the state, not those satellites, is wrong, and the epoch's
+// rows are rejected whole (a lost estimate is then not held by the few satellites that happen to agree
+// with it, and the watchdog sees the rejections).
+inline bool ScreeningKeptMost(size_t kept, size_t offered) { return 2 * kept >= offered; }
 
 // The rows' differences within each group against the group's row of least variance (groups of one row
 // drop out): r_d, H_d, and their noise R_d = D·diag(variance)·Dᵀ. *groups_used: the groups left.
 void DifferenceByGroup(const NuisanceRows& rows, VecX* r_d, MatX* H_d, MatX* R_d, int* groups_used = nullptr);
+// How many differences DifferenceByGroup makes of rows in these groups: the rows less their groups.
+int DifferenceCount(const std::vector<int>& group);
 
 // Rows over a 3-vector x (r_d + H_d·(x − x0), noise R_d; x0 where they were evaluated) as the one constraint
 // they put on x: ‖S·(x − z)‖² equals their whitened squared norm up to a constant. S (3×3) is the square root

@@ -128,12 +128,15 @@ class Eskf : public Estimator {
   void UpdateWheelSpeed(const WheelMeasurement& m);
   void UpdateWheelYawRate(const WheelMeasurement& m);
   void UpdateNonHolonomic(double t);
-  // The tightly coupled updates (eskf_raw_gnss.cc): the epoch's pseudoranges, or its range rates.
-  void UpdateRawGnss(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats, bool rates);
+  // The tightly coupled updates (eskf_raw_gnss.cc): the epoch's pseudoranges, or its range rates. True if
+  // used, false if rejected (by the gate, or every difference screened away), none if there was nothing to
+  // difference.
+  std::optional<bool> UpdateRawGnss(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats, bool rates);
   // The carrier phases' time differences since the previous epoch; then that epoch becomes this one.
   void UpdateRawPhase(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats);
   // Watchdog: before a fix is used, true if its verdict took the fix (held for a course, or re-initialised
-  // from it); after a GNSS position update (accepted or not), true if it re-initialised.
+  // from it); after a GNSS position update or a raw epoch's ranges (accepted or not), true if it
+  // re-initialised.
   bool WatchdogTakes(const GnssMeasurement& m);
   bool WatchGnss(const GnssMeasurement& m, bool accepted);
   void ResetFromGnss(const GnssMeasurement& m, const std::string& reason);

@@ -2,6 +2,7 @@
 // rates of the satellites that pass their own test, differenced within their clock's group, in one
 // iterated update each.
 #include <cmath>
+#include <optional>
 
 #include "core/chi2.h"
 #include "core/so3.h"
@@ -90,6 +91,9 @@ NuisanceRows RawGnssRows(const NavState& x, const Vec3& lever_b, const Vec3& ome
 void Eskf::Use(const RawGnssMeasurement& m) {
   if (!initialized_ || m.t < nom_.x.t || !m.nav) return;
   Propagate(m.t);
+  // The watchdog as for fixes, on the epoch's own single-point fix: its verdict before the epoch is used,
+  // and the ranges' outcome after (a run of rejected epochs re-initialises from the fix).
+  if (m.has_fix && WatchdogTakes(m.fix)) return;
   FlushCovariance();
   const Vec3 omega_b = BodyRate();
   const Antenna a = AntennaAt(nom_.x, sensors_.gnss.lever_b, omega_b, m);
@@ -97,12 +101,21 @@ void Eskf::Use(const RawGnssMeasurement& m) {
   const std::vector<RawSatellite> sats = PrepareSatellites(m, a.r_ecef, &skipped);
   ++raw_.epochs;
   raw_.unusable += skipped;
-  UpdateRawGnss(m, sats, /*rates=*/false);
+  const std::optional<bool> ranges = UpdateRawGnss(m, sats, /*rates=*/false);
+  bool reset = false;
+  if (ranges && m.has_fix) {
+    reset = WatchGnss(m.fix, *ranges);
+  } else if (ranges) {
+    watchdog_.Watch(m.t, *ranges);  // no fix to re-initialise from: the run goes on
+  }
+  if (m.has_fix) prev_fix_ = m.fix;
+  if (reset) return;
   if (m.nav->use_doppler) UpdateRawGnss(m, sats, /*rates=*/true);
   if (m.nav->use_phase) UpdateRawPhase(m, sats);
 }
 
-void Eskf::UpdateRawGnss(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats, bool rates) {
+std::optional<bool> Eskf::UpdateRawGnss(const RawGnssMeasurement& m, const std::vector<RawSatellite>& sats,
+                                        bool rates) {
   const Vec3 omega_b = BodyRate();
   const Vec3& lever_b = sensors_.gnss.lever_b;
   std::vector<const RawSatellite*> in;
@@ -116,13 +129,17 @@ void Eskf::UpdateRawGnss(const RawGnssMeasurement& m, const std::vector<RawSatel
   const NuisanceRows all = rows_at(nom_.x, in);
   const std::vector<const RawSatellite*> kept =
       Screened(in, all, MatX(P_), raw_.w_max, [](const RawSatellite* s) { return s; }, &raw_.satellite_rejected);
+  if (!ScreeningKeptMost(kept.size(), in.size())) {
+    counts.Reject("most_satellites_screened", m.t);
+    return false;
+  }
   VecX r_d;
   MatX H_d, R_d;
   DifferenceByGroup(rows_at(nom_.x, kept), &r_d, &H_d, &R_d);
   const int dof = static_cast<int>(r_d.size());
   if (dof == 0) {
     ++raw_.epochs_without_differences;
-    return;
+    return DifferenceCount(all.group) > 0 ? std::optional<bool>(false) : std::nullopt;
   }
   const Model<Eigen::Dynamic> model = [&] {
     VecX r;
@@ -130,9 +147,9 @@ void Eskf::UpdateRawGnss(const RawGnssMeasurement& m, const std::vector<RawSatel
     DifferenceByGroup(rows_at(nom_.x, kept), &r, &H, &R);
     return Linearized<Eigen::Dynamic>{r, H};
   };
-  if (Update<Eigen::Dynamic>(model, R_d, Chi2Gate(sensors_.gnss.gate_probability, dof), &counts, m.t)) {
-    raw_.satellites_used += kept.size();
-  }
+  if (!Update<Eigen::Dynamic>(model, R_d, Chi2Gate(sensors_.gnss.gate_probability, dof), &counts, m.t)) return false;
+  raw_.satellites_used += kept.size();
+  return true;
 }
 
 nlohmann::json Eskf::RawGnssCounts::ToJson() const {
@@ -200,9 +217,12 @@ void Eskf::UpdateRawPhase(const RawGnssMeasurement& m, const std::vector<RawSate
     };
     if (pairs.size() >= 2) {
       const NuisanceRows all = rows_at(nom_);
+      const size_t offered = pairs.size();
       pairs = Screened(pairs, all, MatX(P_), raw_.w_max, [](const auto& p) { return p.first; },
                        &raw_.satellite_rejected);
-      if (pairs.size() >= 2) {
+      if (!ScreeningKeptMost(pairs.size(), offered)) {
+        raw_.phases.Reject("most_satellites_screened", m.t);
+      } else if (pairs.size() >= 2) {
         VecX r_d;
         MatX H_d, R_d;
         DifferenceByGroup(rows_at(nom_), &r_d, &H_d, &R_d);

@@ -41,10 +41,11 @@ RawGnssAttacher::PredictedAntenna AntennaAt(const Prediction& pred, const Vec3& 
 
 }  // namespace
 
-RawGnssAttacher::RawGnssAttacher(const GnssOptions& gnss)
+RawGnssAttacher::RawGnssAttacher(const GnssOptions& gnss, std::function<void(double, bool)> on_checked)
     : lever_b_(gnss.lever_b),
       gate_probability_(gnss.gate_probability),
-      w_max_(std::sqrt(Chi2Gate(gnss.gate_probability, 1))) {
+      w_max_(std::sqrt(Chi2Gate(gnss.gate_probability, 1))),
+      on_checked_(std::move(on_checked)) {
   // The Huber corner at the gate of a full-rank factor, as the fixes' (smoother_attachers.h).
   const double gate = Chi2Gate(gnss.gate_probability, 3);
   if (std::isfinite(gate)) loss_.reset(new ceres::HuberLoss(std::sqrt(gate)));
@@ -95,6 +96,11 @@ bool RawGnssAttacher::Gate(const NuisanceRows& rows, const std::vector<const Raw
     if (!keep[i]) ++satellite_rejected_[in[i]->sat.ToString()];
   }
   *kept_n = kept_rows.size();
+  if (!ScreeningKeptMost(kept_rows.size(), in.size())) {
+    counts->Reject("most_satellites_screened", t);
+    c->rank = -1;
+    return false;
+  }
   VecX r_d;
   MatX H_d, R_d;
   DifferenceByGroup(kept, &r_d, &H_d, &R_d);
@@ -143,8 +149,11 @@ bool RawGnssAttacher::AttachRows(const RawGnssMeasurement& m, const std::vector<
   size_t kept = 0;
   if (!Gate(rows, in, rates ? a.P_v : a.P_p, rates ? a.v_w : a.p_w, m.t, &counts, &c, &kept)) {
     if (!rates && c.rank == 0) ++epochs_without_differences_;
+    // Rejected: by the gate, or every difference screened away (none to make is no verdict).
+    if (!rates && on_checked_ && (c.rank < 0 || DifferenceCount(rows.group) > 0)) on_checked_(m.t, false);
     return false;
   }
+  if (!rates && on_checked_) on_checked_(m.t, true);
   if (anchor->kf == nullptr) *anchor = ctx.anchor(m.t);
   std::vector<BlockRef> blocks = {{anchor->kf, BlockType::kPose}, {anchor->kf, BlockType::kVelocity}};
   if (anchor->partial != nullptr) blocks.push_back({anchor->kf, BlockType::kBias});

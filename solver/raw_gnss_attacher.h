@@ -14,6 +14,7 @@
 
 #include <ceres/loss_function.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -27,7 +28,9 @@ namespace gins {
 
 class RawGnssAttacher final : public AttacherOf<RawGnssMeasurement> {
  public:
-  explicit RawGnssAttacher(const GnssOptions& gnss);
+  // on_checked(t, accepted): each epoch's ranges' outcome, for the smoother's watchdog (none when there was
+  // nothing to difference).
+  RawGnssAttacher(const GnssOptions& gnss, std::function<void(double, bool)> on_checked);
 
   bool On(const RawGnssMeasurement& m, const AttachContext& ctx) override;
   void AddStats(nlohmann::json* stats) const override;
@@ -59,6 +62,7 @@ class RawGnssAttacher final : public AttacherOf<RawGnssMeasurement> {
   Vec3 lever_b_;
   double gate_probability_;
   double w_max_;  // the standardised residual's bound: √χ²(gnss.gate_probability, 1)
+  std::function<void(double, bool)> on_checked_;
   std::unique_ptr<ceres::LossFunction> loss_;
   MeasurementCounts ranges_, rates_;
   uint64_t epochs_ = 0, satellites_used_ = 0, unusable_ = 0, epochs_without_differences_ = 0;

@@ -56,7 +56,8 @@ Smoother::Smoother(const SensorOptions& sensors, const EskfOptions& eskf, const 
   attachers_.push_back(std::make_unique<GnssAttacher>(
       sensors_.gnss, [this](double t, bool accepted) { WatchGnss(t, accepted); },
       [this](double factor) { RelievePrior(factor); }));
-  attachers_.push_back(std::make_unique<RawGnssAttacher>(sensors_.gnss));
+  attachers_.push_back(std::make_unique<RawGnssAttacher>(
+      sensors_.gnss, [this](double t, bool accepted) { WatchGnss(t, accepted); }));
   pre_init_.SetBackwardFiller([this](const BackwardSpan& span) {
     return FillBackward(sensors_, eskf_options_, standstill_options_, span);
   });
@@ -293,7 +294,13 @@ void Smoother::Use(const GnssVelocityMeasurement& x, const Measurement& m) {
 void Smoother::Use(const RawGnssMeasurement& x, const Measurement& m) {
   if (!initialized_ || !x.nav || x.t < t_now_ - kSameEpoch || x.t < window_.back().t - kSameEpoch) return;
   if (x.t > window_.back().t + kSameEpoch) SolveIfPending();
-  if (Attach(m)) solve_pending_ = true;
+  // The watchdog as for fixes, on the epoch's own single-point fix (the ranges' outcome: RawGnssAttacher).
+  if (!x.has_fix) {
+    if (Attach(m)) solve_pending_ = true;
+    reset_reason_.clear();  // no fix to rebuild from: the run goes on
+  } else if (!WatchdogTakes(x.fix)) {
+    AttachWatched(x.fix, m);
+  }
 }
 
 void Smoother::Use(const WheelMeasurement& x, const Measurement& m) {

@@ -102,7 +102,7 @@ class Smoother : public Estimator {
   void CountCovarianceFailure(const char* what);
   ceres::ResidualBlockId AddImuFactor(Keyframe& prev, Keyframe& kf);
   void WatchGnss(double t, bool accepted);
-  // The watchdog's verdict before a fix is used: true if it took the fix
+  // The watchdog's verdict before a fix (logged, or a raw epoch's own) is used: true if it took the fix
   // (held for a course, or the window rebuilt from it).
   bool WatchdogTakes(const GnssMeasurement& m);
   // Attaches the measurement carrying fix, and rebuilds the window from fix if its outcome made the

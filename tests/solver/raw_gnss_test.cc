@@ -260,5 +260,64 @@ TEST(RawGnss, UrbanCanyonDriftsFarLessTightlyThanLoosely) {
   EXPECT_EQ(tight.stats["gnss_raw"]["fix_failures"]["too few satellites"].get<uint64_t>(), 60u);
 }
 
+// An IMU glitch while driving without fixes (2 s of accelerometer x reading 20 m/s² too much, say a
+// saturated or corrupted sensor) throws both estimators tens of metres off with the covariance of a good
+// IMU: every epoch's ranges fail the gate from then on. After watchdog.max_reject_s of rejected epochs
+// the watchdog re-initialises each from the epoch's own single-point fix, as it does from a logged fix,
+// and the ranges bring it back to decimetres. Without the watchdog the run stays lost.
+TEST(RawGnss, WatchdogReinitialisesALostTightlyCoupledRun) {
+  const SimOptions sim = RawDrive(33);
+  const double glitch = sim.start_time + 75.0;
+  auto run_with = [&](bool watchdog, double glitch_acc) {
+    Options options = RawOptions(sim);
+    options.watchdog.enabled = watchdog;
+    const test::RecordHook raw = WithRawEpochs(sim, RawSim(), false);
+    const test::RecordHook hook = [&](const SimRecord& rec, const std::function<void(const SimRecord&)>& feed,
+                                      EstimatorPipeline& session) {
+      if (!rec.is<ImuSample>() || rec.t() < glitch || rec.t() >= glitch + 2.0) return raw(rec, feed, session);
+      SimRecord bad = rec;
+      bad.get<ImuSample>().acc.x() += glitch_acc;
+      raw(bad, feed, session);
+    };
+    return test::RunDriveThroughSession(sim, options, hook);
+  };
+  const test::DriveRun on = run_with(true, 20.0);
+  const test::DriveRun off = run_with(false, 20.0);
+  const test::DriveRun clean = run_with(true, 0.0);
+  ASSERT_TRUE(on.initialized && off.initialized && clean.initialized);
+  const double from = glitch + 50.0;
+  for (const char* name : {"eskf", "smoother"}) {
+    SCOPED_TRACE(name);
+    const bool eskf = std::string(name) == "eskf";
+    const test::DriveErrors after = test::Errors(on, eskf ? on.eskf : on.smoother, from);
+    const test::DriveErrors lost = test::Errors(off, eskf ? off.eskf : off.smoother, from);
+    const test::DriveErrors unhurt = test::Errors(clean, eskf ? clean.eskf : clean.smoother, from);
+    test::PrintErrors((std::string(name) + " without the glitch").c_str(), unhurt);
+    test::PrintErrors((std::string(name) + " after the reset").c_str(), after);
+    test::PrintErrors((std::string(name) + " without the watchdog").c_str(), lost);
+    const nlohmann::json& w = on.stats["estimators"][name]["watchdog"];
+    std::printf("  %s watchdog %s, ranges %s\n", name, w.dump().c_str(),
+                on.stats["estimators"][name]["gnss_raw"].dump().c_str());
+    ASSERT_GE(w["count"].get<uint64_t>(), 1u);
+    EXPECT_EQ(w["resets"][0]["reason"].get<std::string>(), "gnss_rejected");
+    EXPECT_GT(w["resets"][0]["time"].get<double>(), glitch);
+    EXPECT_LT(w["resets"][0]["time"].get<double>(), glitch + 2.0 + WatchdogOptions().max_reject + 3.0);
+    EXPECT_EQ(clean.stats["estimators"][name]["watchdog"]["count"].get<uint64_t>(), 0u);
+    // Back on the ranges: below the single-point fixes' metres (the reset's own error), and within the
+    // estimate's own σ (at least 95 % of the states inside 3 σ horizontally). The clean drive, averaging
+    // pseudoranges 50 s longer, is closer.
+    EXPECT_LT(after.rmse_h, 1.0);
+    size_t n = 0, inside = 0;
+    test::ForEachAtTruth(on, eskf ? on.eskf : on.smoother, from, 1e300, [&](const StateEstimate& e, size_t j) {
+      const Vec3 d = e.x.p_wb - on.truth[j].p_wb;
+      ++n;
+      inside += std::abs(d.x()) <= 3.0 * e.sigma_p.x() && std::abs(d.y()) <= 3.0 * e.sigma_p.y();
+    });
+    std::printf("  %s: %zu of %zu states within 3 sigma\n", name, inside, n);
+    EXPECT_GE(static_cast<double>(inside), 0.95 * static_cast<double>(n));
+    EXPECT_GT(lost.rmse_h, 10.0);
+  }
+}
+
 }  // namespace
 }  // namespace gins

@@ -13,7 +13,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 namespace fs = std::filesystem;
 

@@ -20,7 +20,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 const std::string kSample = std::string(GINS_TEST_DATA_DIR) + "/sample/log.txt.gz";
 const std::string kConfig = std::string(GINS_SOURCE_DIR) + "/config/default.yaml";

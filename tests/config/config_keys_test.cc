@@ -15,7 +15,7 @@
 #include "config/config_loader.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 std::string ReadDefaultYaml() {
   std::ifstream in(GINS_SOURCE_DIR "/config/default.yaml");

@@ -12,7 +12,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 const std::string kConfigDir = GINS_SOURCE_DIR "/config/";
 

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(Chi2, QuantilesMatchTables) {
   EXPECT_NEAR(Chi2Quantile(0.95, 1), 3.841459, 1e-5);

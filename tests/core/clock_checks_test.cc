@@ -5,7 +5,7 @@
 #include <cmath>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // A car driving a straight road for 300 s with its speed changing (about 1 m/s² peaks: stops and starts),
 // IMU at 100 Hz (forward specific force = the speed's rate, plus a pitch's constant), 1 Hz RTK fixes stamped

@@ -19,7 +19,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 namespace fs = std::filesystem;
 

@@ -6,7 +6,7 @@
 #include <cmath>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 const LocalEnuFrame kFrame(GeodeticPoint{31.5, 120.4, 10.0});
 

@@ -9,7 +9,7 @@
 #include <cmath>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(LocalEnuFrame, RoundTripAndAxes) {
   const LocalEnuFrame frame({31.5, 120.4, 10.0});

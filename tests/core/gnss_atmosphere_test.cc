@@ -6,7 +6,7 @@
 #include "core/gnss_atmosphere.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(GnssAtmosphere, AzimuthElevationOfKnownDirections) {
   // On the equator at longitude 0, the local ENU axes are ECEF (y, z, x).

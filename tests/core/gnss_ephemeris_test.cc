@@ -4,7 +4,7 @@
 #include "core/gnss_ephemeris.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(GnssEphemeris, SatelliteIdPrintsAsRinexWritesIt) {
   EXPECT_EQ((SatelliteId{GnssSystem::kGps, 5}).ToString(), "G05");

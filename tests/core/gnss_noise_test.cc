@@ -8,7 +8,7 @@
 #include <random>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(CorrelatedNoiseInflation, WhiteErrorsAndLongGapsKeepTheirSigma) {
   EXPECT_DOUBLE_EQ(CorrelatedNoiseInflation(0.05, 0.0), 1.0);

@@ -10,7 +10,7 @@
 #include "core/io/rinex.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // The GPS ephemeris of szymon2024/gps-labs, gps_lab02 (an independent Haskell transcription of IS-GPS-200
 // Table 20-IV), whose printed result at week 2304, 424830 s is X = 22151566.575334515,

@@ -16,7 +16,7 @@
 #include "core/sim/raw_gnss.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kT0 = 1440437500.0;  // GPS s: walk.nav's records are in date
 

@@ -18,7 +18,7 @@
 #include "core/io/rinex.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 const std::array<double, 4> kRtklibAlpha = {0.1118E-07, -0.7451E-08, -0.5961E-07, 0.1192E-06};
 const std::array<double, 4> kRtklibBeta = {0.1167E+06, -0.2294E+06, -0.1311E+06, 0.1049E+07};

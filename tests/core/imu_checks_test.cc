@@ -9,7 +9,7 @@
 #include <string>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // kSamples of specific force `f` plus white noise σ (m/s²), then the verdict.
 ImuAxesAndUnitsCheck::Outcome Judge(const Vec3& f, bool land_vehicle, std::string* message = nullptr) {
@@ -66,7 +66,7 @@ TEST(ImuAxesAndUnitsCheck, ZDownIsRefusedForACarAndWarnedOtherwise) {
 }  // namespace gins
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // A car at 10 m/s on 1 Hz fixes (2 cm), level, turning at `rate` (rad/s, true) for 30 s after 10 s straight;
 // the gyro reads gyro_scale × the true rate; mirror: the track's north flipped (a mirrored track).

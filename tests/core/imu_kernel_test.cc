@@ -6,7 +6,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // Error of the propagated state, in the kernel's order (δp, δv, δθ), relative to the nominal step.
 Vec9 StepError(const Kinematics& nominal_out, const Kinematics& perturbed_out) {
@@ -99,7 +99,7 @@ TEST(ImuDiscreteNoise, ScalesWithRate) {
 }  // namespace gins
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // With Earth rotation the kernel adds Coriolis and turns w under the body; its Jacobians still match
 // numeric differences (an exaggerated rate makes the terms visible), and the structured products still

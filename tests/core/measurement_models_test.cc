@@ -12,7 +12,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 struct State {
   Vec3 p_wb, v_w;

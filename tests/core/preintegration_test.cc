@@ -14,7 +14,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kG = 9.81;
 
@@ -252,7 +252,7 @@ TEST(PreintegrationTest, ReintegrateAtSameBiasIsIdentityAndZeroDtIsIgnored) {
 }  // namespace gins
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // PredictedCovariance equals the filter's step-by-step propagation of the same error state through the
 // kernel's Jacobians (F = [[A, B], [0, I]], the same discrete white noise): both are the linearised model of

@@ -8,7 +8,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 Vec3 RandomVec(std::mt19937& rng, double scale) {
   std::normal_distribution<double> n(0.0, scale);

@@ -5,7 +5,7 @@
 #include <random>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kG = 9.8;
 constexpr double kRate = 100.0;  // Hz

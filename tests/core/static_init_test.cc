@@ -20,7 +20,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 struct InitRun {
   bool done = false;
@@ -255,7 +255,7 @@ TEST(StaticInitializer, NeverStandingStillInitialisesInMotion) {
 }  // namespace gins
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // When a fit starts the estimators (FitStartsEstimators): precise enough, or settled over a full window.
 TEST(FitStartsEstimators, PreciseOrSettledOverAFullWindow) {

@@ -5,7 +5,7 @@
 #include <cmath>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // Unix UTC of 2017-01-01 00:00:00: the 18th leap second was inserted just before it.
 constexpr double kLeap2017 = 1483228800.0;

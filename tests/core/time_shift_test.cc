@@ -5,7 +5,7 @@
 #include <cmath>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // A car on a circle of radius r at rate w (heading along the track, FLU body): the exact state at any time.
 struct Circle {

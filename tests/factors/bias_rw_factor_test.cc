@@ -9,7 +9,7 @@
 #include "factors/scale_rw_factor.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(BiasRwFactorTest, ResidualIsWhitenedDifference) {
   const double sg = 3e-4, sa = 2e-4, dt = 0.25;

@@ -16,7 +16,7 @@
 #include "factors/gnss_factor.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 template <class M>
 void ExpectDelayedMatches(const M& measurement, const std::string& what) {

@@ -16,7 +16,7 @@
 #include "factors/wheel_factor.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 using RowMatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 using Mat76 = Eigen::Matrix<double, pose::kAmbient, pose::kTangent, Eigen::RowMajor>;

@@ -8,7 +8,7 @@
 #include "factor_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(GnssFactorTest, ResidualAtTruthAndWhitening) {
   std::mt19937 rng(11);

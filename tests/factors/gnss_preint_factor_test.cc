@@ -11,7 +11,7 @@
 #include "factor_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 struct Scenario {
   test::PoseBlock pose_i;

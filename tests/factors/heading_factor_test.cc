@@ -9,7 +9,7 @@
 #include "factor_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // Yaw of the antenna frame G = b·Rz(mount_yaw) for a pose.
 double AntennaYaw(const test::PoseBlock& pose, double mount_yaw) {

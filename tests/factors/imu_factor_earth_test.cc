@@ -15,7 +15,7 @@
 #include "factors/imu_factor.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kG = 9.81;
 

@@ -13,7 +13,7 @@
 #include "factor_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kG = 9.81;
 

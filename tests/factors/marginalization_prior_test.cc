@@ -21,7 +21,7 @@
 #include "factors/wheel_factor.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kG = 9.81;
 constexpr int kNumKf = 3;

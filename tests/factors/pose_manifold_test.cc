@@ -9,7 +9,7 @@
 #include "factor_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 using ceres::HasCorrectMinusJacobianAt;
 using ceres::HasCorrectPlusJacobianAt;

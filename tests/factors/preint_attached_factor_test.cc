@@ -15,7 +15,7 @@
 #include "factors/raw_gnss_factor.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 template <class Measurement>
 void ExpectAnalyticMatches(const Measurement& measurement, const std::string& what) {

@@ -12,7 +12,7 @@
 #include "factor_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(RawGnssFactorTest, RangeResidualIsTheWhitenedAntennaOffset) {
   std::mt19937 rng(21);

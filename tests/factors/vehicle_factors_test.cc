@@ -13,7 +13,7 @@
 #include "factors/wheel_yaw_factor.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 const Vec3 kLever(-1.5, 0.1, -0.3);  // rear-axle centre 1.5 m behind the IMU
 

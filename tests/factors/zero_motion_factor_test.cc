@@ -8,7 +8,7 @@
 #include "factor_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(ZeroMotionFactorTest, ZeroWhenStillAndScaledBySigma) {
   std::mt19937 rng(21);

@@ -12,7 +12,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 using test::DriveRun;
 using test::Errors;

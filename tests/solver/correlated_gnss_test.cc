@@ -10,7 +10,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 struct Nees {
   double eskf = 0.0, smoother = 0.0;

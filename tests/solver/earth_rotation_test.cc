@@ -10,7 +10,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 SimOptions TacticalDrive() {
   SimOptions s = test::TestDrive(11);

@@ -9,7 +9,7 @@
 #include <vector>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // A 1-D constant-velocity target (position, velocity) with white acceleration, position fixes, and a
 // run of epochs without a fix (an outage) in the middle.

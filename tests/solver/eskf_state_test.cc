@@ -10,7 +10,7 @@
 #include "solver/eskf_update.h"
 
 namespace gins::eskf {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(EskfState, BlocksAreContiguousAndCoverTheState) {
   int next = 0;

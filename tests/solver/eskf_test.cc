@@ -14,7 +14,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 struct DriveResult {
   double rmse_h = 0, max_h = 0, rmse_v = 0, rmse_vel = 0, rmse_yaw_deg = 0, max_h_outage = 0;

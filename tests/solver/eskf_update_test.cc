@@ -10,7 +10,7 @@
 #include "core/chi2.h"
 
 namespace gins::eskf {
-namespace {
+namespace GINS_TEST_FILE {
 
 template <int N>
 Eigen::Matrix<double, N, N> RandomSpd(std::mt19937* rng, double min_eig) {

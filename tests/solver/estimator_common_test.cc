@@ -13,7 +13,7 @@
 #include "core/so3.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(MeasurementCounts, OfferedIsUsedPlusEveryRejection) {
   MeasurementCounts c;

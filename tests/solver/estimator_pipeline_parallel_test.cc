@@ -15,7 +15,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 struct Streams {
   std::vector<StateEstimate> eskf, eskf_rts, smoother, online, batch;

@@ -13,7 +13,7 @@
 #include "fault_harness.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 using test::DriveRun;
 using test::Editing;

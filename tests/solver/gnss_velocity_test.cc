@@ -8,7 +8,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 SimOptions SinglePointDrive(unsigned seed) {
   SimOptions sim = test::TestDrive(seed);

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 nlohmann::json Stats(uint64_t used, uint64_t rejected, uint64_t resets) {
   nlohmann::json j;

@@ -9,7 +9,7 @@
 #include "core/so3.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 struct Case {
   StateEstimate a;

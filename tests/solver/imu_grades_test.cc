@@ -16,7 +16,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 struct Grade {
   const char* name;

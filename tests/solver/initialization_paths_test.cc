@@ -18,7 +18,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kDeg = kDegToRad;
 

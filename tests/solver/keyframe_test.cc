@@ -14,7 +14,7 @@
 #include "window_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 const std::vector<BlockType> kNavBlocks = {BlockType::kPose, BlockType::kVelocity, BlockType::kBias};
 

@@ -11,7 +11,7 @@
 #include "window_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // Tangent column of each block in `blocks`.
 std::map<const double*, int> ColumnsOf(ceres::Problem* problem, const std::vector<double*>& blocks) {

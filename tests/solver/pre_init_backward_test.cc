@@ -14,7 +14,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 struct Drive {
   std::vector<ImuSample> imu;

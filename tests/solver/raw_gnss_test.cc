@@ -20,7 +20,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 const RinexNav& WalkNav() {
   static const RinexNav nav = ReadRinexNav(std::string(GINS_TEST_DATA_DIR) + "/rinex/walk.nav", InputOptions{});

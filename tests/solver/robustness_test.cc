@@ -22,7 +22,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // A record of the simulated stream may be changed (return true) or dropped (return false) before the
 // session sees it.

@@ -15,7 +15,7 @@
 #include "window_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 class AttacherTest : public ::testing::Test {
  protected:

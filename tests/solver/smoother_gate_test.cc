@@ -11,7 +11,7 @@
 #include "core/so3.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(PredictBlockCovariance, BlocksOutsideNavStateAreRandomWalksOfTheirOwnSigma) {
   SensorOptions sensors;

@@ -10,7 +10,7 @@
 #include "window_test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(SmootherOutput, OldestCovarianceIsTheDenseInverseOfTheWindowInformation) {
   for (bool estimate_scale : {false, true}) {

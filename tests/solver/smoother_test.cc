@@ -20,7 +20,7 @@
 #include "test_scenarios.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 bool InOutage(const SimOptions& sim, double t, double after) {
   for (const auto& [start, dur] : sim.gnss_outages) {

@@ -16,7 +16,7 @@
 #include "fuzz/stream_harness.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 std::vector<uint8_t> ReadBytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);

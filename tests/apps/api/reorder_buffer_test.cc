@@ -9,7 +9,7 @@
 #include <vector>
 
 namespace gins::api {
-namespace {
+namespace GINS_TEST_FILE {
 
 LogRecord At(double t, uint64_t tag) {
   ImuSample imu;

@@ -13,7 +13,7 @@
 #include "gins/gins.h"
 
 namespace gins::api {
-namespace {
+namespace GINS_TEST_FILE {
 
 const std::string kSample = std::string(GINS_TEST_DATA_DIR) + "/sample/log.txt.gz";
 

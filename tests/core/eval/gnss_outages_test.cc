@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kFirst = 1700000000.0;
 

@@ -19,7 +19,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 const GeodeticPoint kOrigin{31.5, 120.4, 10.0};
 constexpr double kT0 = 1700000000.0;

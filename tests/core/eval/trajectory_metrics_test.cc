@@ -13,7 +13,7 @@
 #include "core/so3.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kT0 = 5000.0;
 

@@ -22,7 +22,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kT0 = 1000.0;
 constexpr double kTruthDt = 0.125;  // 8 Hz; binary-exact times keep the bracketing unambiguous

@@ -12,7 +12,7 @@
 #include "tests/test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // Small lines through the buffer and writes larger than it (stdio hands those over whole) interleave in
 // order, over many more chunks than may wait at once.

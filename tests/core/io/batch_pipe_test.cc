@@ -8,7 +8,7 @@
 #include <vector>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(BatchPipe, ConsumesEverythingInOrderOnAnotherThread) {
   std::vector<int> seen;

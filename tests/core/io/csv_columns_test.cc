@@ -10,7 +10,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 struct Read {
   std::vector<LogRecord> records;

@@ -11,7 +11,7 @@
 #include <vector>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 using Writer = void (*)(const GeoTrack&, const GeoWriteOptions&, std::FILE*);
 

@@ -12,7 +12,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kT0 = 1440437439.0;  // GPS seconds: 2025-08-28 17:30:39 GPST
 

@@ -8,7 +8,7 @@
 #include "core/io/nmea_parse.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(GnssFormats, QualityNamesRoundTripInBestFirstOrder) {
   const char* names[] = {"fix", "float", "ppp", "dgps", "sbas", "single"};

@@ -8,7 +8,7 @@
 #include <vector>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // 2025-08-28 17:30:39.75 GPST, the rtkx walk's first epoch, in GPS seconds since 1980-01-06.
 constexpr double kWalkGps = 1440437439.75;

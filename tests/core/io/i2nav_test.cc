@@ -16,7 +16,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kT0 = 357000.0;  // GPS seconds of week, as in i2Nav's sample data
 

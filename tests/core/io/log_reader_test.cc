@@ -14,7 +14,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 using namespace std::string_literals;  // "..."s keeps embedded NUL bytes
 

@@ -11,7 +11,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 void WriteSample(LogWriter* w) {
   w->Comment("made by a test\nsecond line");

@@ -8,7 +8,7 @@
 #include <string>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 std::string S(const std::string& body, bool lower = false) {
   unsigned x = 0;

@@ -10,7 +10,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kWalkGps = 1440437439.75;  // 2025-08-28 17:30:21.75 UTC = 17:30:39.75 GPST
 constexpr double kKnot = 1852.0 / 3600.0;

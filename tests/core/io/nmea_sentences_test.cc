@@ -8,7 +8,7 @@
 #include <vector>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // 2025-08-28 17:30:22.25 UTC (GPS second 1440437440.25).
 constexpr double kKnownUtc = 1756402222.25;

@@ -11,7 +11,7 @@
 #include <vector>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 std::string Ours(double v, int precision, bool scientific) {
   char buf[64];

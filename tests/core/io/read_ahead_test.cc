@@ -8,7 +8,7 @@
 #include <thread>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(ReadAhead, YieldsEverythingInOrderFromAnotherThread) {
   int next = 0;

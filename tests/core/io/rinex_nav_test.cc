@@ -11,7 +11,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 std::string H(const std::string& content, const std::string& label) {
   std::string s = content;

@@ -13,7 +13,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kWalkGps = 1440437439.748;  // 2025-08-28 17:30:39.748 GPST
 

@@ -14,7 +14,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 bool Exists(const std::string& path) { return std::ifstream(path).good(); }
 

@@ -11,7 +11,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kWalkGps = 1440437439.75;  // 2025-08-28 17:30:39.75 GPST
 

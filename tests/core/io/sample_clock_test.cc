@@ -10,7 +10,7 @@
 #include <vector>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 TEST(SampleClock, RegularStreamsAndRateChangesPassUnchanged) {
   SampleClock clock(0.5);

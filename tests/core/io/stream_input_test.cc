@@ -10,7 +10,7 @@
 #include "core/io/log_reader.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 std::string Imu(const std::string& t) { return "IMU " + t + " 0.01 -0.02 0.03 0.1 -0.2 9.8\n"; }
 

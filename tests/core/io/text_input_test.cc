@@ -11,7 +11,7 @@
 #include <string>
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // The reference: strtod over the whole token (ParseNumber also takes a leading '+').
 void ExpectStrtod(const std::string& token) {

@@ -18,7 +18,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 constexpr double kT0 = 1440437500.0;  // GPS s, 2025-08-28 17:31:40 GPST: walk.nav's records are in date
 

@@ -18,7 +18,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 using test::FarDrive;
 using test::NoiseFreeSim;

@@ -19,7 +19,7 @@
 #include "test_util.h"
 
 namespace gins {
-namespace {
+namespace GINS_TEST_FILE {
 
 // 60 s: standstill, accelerate, climbing left turn, level right turn, descending left turn while braking,
 // accelerate, brake hard enough to stop (the speed clamp engages for the last ~3 s).

@@ -4,7 +4,7 @@
 <regex>: GCC 12 warns inside std::regex (-Wmaybe-uninitialized) at the sanitizer build's -O1, which
 -Werror turns into a failed CI run, while the Release build stays quiet. Parse by hand instead.
 
-An anonymous namespace in a test file (tests/**/*_test.cc): the tests are compiled several files to a
+An anonymous namespace in a test file (tests/**/*_test.cc, tests/test_util.cc): the tests are compiled several files to a
 translation unit (a unity build, tests/CMakeLists.txt), where two files' helpers of the same name would
 clash or, worse, overload each other. Their helpers go in `namespace GINS_TEST_FILE`, unique per file.
 
@@ -29,7 +29,8 @@ def main():
                 if not entry.endswith((".h", ".cc", ".cpp")):
                     continue
                 path = os.path.join(directory, entry)
-                test_file = folder == "tests" and entry.endswith("_test.cc")
+                # The sources of the test executables, which tests/CMakeLists.txt compiles as a unity build.
+                test_file = folder == "tests" and (entry.endswith("_test.cc") or entry == "test_util.cc")
                 with open(path, encoding="utf-8", errors="replace") as f:
                     for number, line in enumerate(f, 1):
                         m = SYSTEM_INCLUDE.match(line)

@@ -10,6 +10,7 @@
 
 #include "core/conventions.h"
 #include "core/geodesy.h"
+#include "core/measurement_modules.h"
 
 namespace gins {
 
@@ -124,6 +125,7 @@ struct SensorOptions {
   WheelOptions wheel;
   VehicleOptions vehicle;
   GravityOptions gravity;
+  MeasurementModules::Options modules;  // each measurement module's section (core/measurement_modules.h)
 };
 
 }  // namespace gins

@@ -47,6 +47,7 @@ Eskf::Eskf(const SensorOptions& sensors, const EskfOptions& eskf, const Standsti
   gate_wheel_yaw_ = Chi2Gate(sensors_.wheel.gate_probability, 1);
   gate_zupt_ = Chi2Gate(sensors_.wheel.gate_probability, 3);
   gate_zero_rate_ = Chi2Gate(kZeroRateGateProbability, 3);
+  SetModuleGates();
   pre_init_.SetBackwardFiller([this](const BackwardSpan& span) {
     return FillBackward(sensors_, eskf_options_, standstill_options_, span);
   });
@@ -417,6 +418,7 @@ nlohmann::json Eskf::Stats() const {
   j["gnss_reacquired"] = gnss_inflation_.reacquired();
   j["gnss_gate_scale"] = {{"final", gnss_consistency_.scale()}, {"max", gnss_consistency_.max_scale()}};
   j["zero_velocity"] = zupt_counts_.ToJson();
+  AddModuleStats(&j);
   j["final_odom_scale"] = nom_.Scalar<Block::kS>();
   // The GNSS time offset: the stated value plus the estimated part (gnss.time_offset_s).
   j["time_offset"] =

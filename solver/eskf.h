@@ -23,12 +23,14 @@
 // speed is above standstill.max_speed_m_s; a reset re-initialises from the current fix (ResetPositionFromFix).
 #pragma once
 
+#include <array>
 #include <functional>
 #include <map>
 #include <initializer_list>
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -59,7 +61,15 @@ class Eskf : public Estimator {
   void Initialize(const InitResult& init) override;
   void AddImu(const ImuSample& imu) override;
   void Add(const Measurement& m) override {
-    std::visit([this](const auto& x) { Use(x); }, m);
+    std::visit(
+        [&](const auto& x) {
+          if constexpr (MeasurementModules::kHasMeasurement<std::decay_t<decltype(x)>>) {
+            UseModule(m);
+          } else {
+            Use(x);
+          }
+        },
+        m);
   }
   void AddRestState(const StateEstimate& s) override;
   void Finish() override;
@@ -103,6 +113,11 @@ class Eskf : public Estimator {
   void Use(const WheelMeasurement& m);
   void Use(const StandstillMeasurement& m);
   void Use(const RawGnssMeasurement& m);
+  // A measurement module's (core/measurement_module.h; eskf_modules.cc): its model linearised at the nominal
+  // state, gated by the module's gate_probability. Its gates are set at construction (SetModuleGates).
+  void UseModule(const Measurement& m);
+  void SetModuleGates();
+  void AddModuleStats(nlohmann::json* stats) const;
   // A measurement model linearised at the filter's current nominal state: its residual r = h(x) − z and
   // full-width Jacobian (from the blocks it touches, eskf::EmbedJacobian).
   template <int M>
@@ -187,6 +202,8 @@ class Eskf : public Estimator {
   ImuGapLog imu_gaps_;
   MeasurementCounts gnss_counts_, heading_counts_, gnss_velocity_counts_, wheel_counts_, wheel_yaw_counts_, nhc_counts_,
       zupt_counts_;
+  std::array<MeasurementCounts, MeasurementModules::kSize> module_counts_;  // by module
+  std::array<double, MeasurementModules::kSize> module_gates_{};
 
   // Raw GNSS (eskf_raw_gnss.cc): the epochs' updates, and each satellite's fate.
   struct RawGnssCounts {

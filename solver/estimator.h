@@ -11,6 +11,7 @@
 
 #include "core/gnss_raw.h"
 #include "core/initializer.h"
+#include "core/measurement_modules.h"
 #include "core/measurements.h"
 #include "core/nav_state.h"
 
@@ -34,9 +35,10 @@ using StateCallback = std::function<void(const StateEstimate&)>;
 // - a standstill (the pipeline's detector: wheels at zero and IMU quiet, or IMU quiet without wheels) at
 //   most every 0.1 s while the vehicle stands, right after the IMU sample at its time;
 // - a raw GNSS epoch (core/gnss_raw.h) carries its own single-point fix, for an estimator that takes fixes
-//   only.
-using Measurement =
-    std::variant<GnssMeasurement, GnssVelocityMeasurement, WheelMeasurement, StandstillMeasurement, RawGnssMeasurement>;
+//   only;
+// - a measurement module's (core/measurement_modules.h) comes at its record's time.
+using Measurement = MeasurementModules::MeasurementsAfter<GnssMeasurement, GnssVelocityMeasurement, WheelMeasurement,
+                                                          StandstillMeasurement, RawGnssMeasurement>;
 
 class Estimator {
  public:

@@ -5,6 +5,7 @@
 // the simulator.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <deque>
 #include <functional>
@@ -13,6 +14,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -66,6 +68,10 @@ class EstimatorPipeline {
   // estimator (Estimator::Add), with that fix when it has one (estimator_pipeline_raw.cc).
   void SetRawGnssFeed(std::unique_ptr<RawGnssFeed> feed);
   void AddRawGnss(RawGnssMeasurement m);
+  // A measurement module's record (core/measurement_module.h): in w, to every estimator once initialised;
+  // before the world frame, before the initialisation, or with the module disabled, counted and dropped.
+  template <typename R>
+  void AddModuleRecord(const R& r);
   // A log's record (or a simulated one) to the Add* of its type: the one dispatch before the estimators.
   void Add(const LogRecord& r);
   // End of the data: flushes the estimators. Throws RunError if initialisation never completed.
@@ -159,6 +165,7 @@ class EstimatorPipeline {
   std::optional<GeodeticPoint> last_fix_geo_;
   std::optional<double> last_fix_t_;  // the previous fix's time (gnss.error_correlation_s)
   uint64_t gvel_unused_ = 0;
+  std::array<uint64_t, MeasurementModules::kSize> module_unused_{};  // by module
   // Wheel records: the previous one's time (its spacing is the counting interval), jitter and gaps.
   WheelMeasurement WheelFromOdom(const WheelRecord& o);
   std::optional<double> last_wheel_t_;
@@ -207,15 +214,39 @@ class EstimatorPipeline {
   uint64_t outage_dropped_ = 0, outage_kept_before_init_ = 0;
 };
 
+template <typename R>
+void EstimatorPipeline::AddModuleRecord(const R& r) {
+  constexpr size_t i = MeasurementModules::IndexOfRecord<R>();
+  using Mod = MeasurementModules::At<i>;
+  DrainRawGnss(r.t);
+  Touch(r.t);
+  std::optional<typename Mod::Measurement> m;
+  if (initialized_) m = Mod::ToMeasurement(r, std::get<i>(sensors_.modules), *frame_);
+  if (!m) {
+    ++module_unused_[i];
+    return;
+  }
+  Dispatch(&Estimator::Add, Measurement(std::move(*m)));
+}
+
 inline void EstimatorPipeline::Add(const LogRecord& r) {
-  struct ToAdd {
-    EstimatorPipeline* pipeline;
-    void operator()(const ImuSample& m) const { pipeline->AddImu(m); }
-    void operator()(const WheelRecord& m) const { pipeline->AddWheel(m); }
-    void operator()(const GnssRecord& m) const { pipeline->AddGnss(m); }
-    void operator()(const GnssVelocityRecord& m) const { pipeline->AddGnssVelocity(m); }
-  };
-  std::visit(ToAdd{this}, r.data);
+  std::visit(
+      [this](const auto& m) {
+        using R = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<R, ImuSample>) {
+          AddImu(m);
+        } else if constexpr (std::is_same_v<R, WheelRecord>) {
+          AddWheel(m);
+        } else if constexpr (std::is_same_v<R, GnssRecord>) {
+          AddGnss(m);
+        } else if constexpr (std::is_same_v<R, GnssVelocityRecord>) {
+          AddGnssVelocity(m);
+        } else {
+          static_assert(MeasurementModules::kHasRecord<R>, "a record type without its Add");
+          AddModuleRecord(m);
+        }
+      },
+      r.data);
 }
 
 }  // namespace gins

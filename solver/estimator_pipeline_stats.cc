@@ -10,6 +10,11 @@ nlohmann::json EstimatorPipeline::Stats() const {
   namespace k = summary_keys;
   j[k::kOdomIgnoredWheelDisabled] = odom_ignored_;
   j[k::kGvelUnused] = gvel_unused_;
+  MeasurementModules::ForEach([&](auto tag) {  // "baro_unused": before the initialisation, or disabled
+    using Mod = typename decltype(tag)::type;
+    const uint64_t n = module_unused_[MeasurementModules::IndexOf<Mod>()];
+    if (n > 0) j[std::string(Mod::Record::kInfo.count_key) + "_unused"] = n;
+  });
   j[k::kImuIntervalJitter] = imu_jitter_;
   j[k::kImuRateChanges] = imu_rate_changes_;
   j[k::kImuSameStamp] = imu_same_stamp_;

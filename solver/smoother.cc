@@ -58,6 +58,7 @@ Smoother::Smoother(const SensorOptions& sensors, const EskfOptions& eskf, const 
       [this](double factor) { RelievePrior(factor); }));
   attachers_.push_back(std::make_unique<RawGnssAttacher>(
       sensors_.gnss, [this](double t, bool accepted) { WatchGnss(t, accepted); }));
+  AddModuleAttachers(sensors_, &attachers_);
   pre_init_.SetBackwardFiller([this](const BackwardSpan& span) {
     return FillBackward(sensors_, eskf_options_, standstill_options_, span);
   });
@@ -301,6 +302,12 @@ void Smoother::Use(const RawGnssMeasurement& x, const Measurement& m) {
   } else if (!WatchdogTakes(x.fix)) {
     AttachWatched(x.fix, m);
   }
+}
+
+void Smoother::UseModule(double t, const Measurement& m) {
+  if (!initialized_ || t < t_now_ - kSameEpoch || t < window_.back().t - kSameEpoch) return;
+  if (t > window_.back().t + kSameEpoch) SolveIfPending();
+  if (Attach(m)) solve_pending_ = true;
 }
 
 void Smoother::Use(const WheelMeasurement& x, const Measurement& m) {

@@ -30,6 +30,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -61,7 +62,15 @@ class Smoother : public Estimator {
   void Initialize(const InitResult& init) override;
   void AddImu(const ImuSample& imu) override;
   void Add(const Measurement& m) override {
-    std::visit([&](const auto& x) { Use(x, m); }, m);
+    std::visit(
+        [&](const auto& x) {
+          if constexpr (MeasurementModules::kHasMeasurement<std::decay_t<decltype(x)>>) {
+            UseModule(x.t, m);
+          } else {
+            Use(x, m);
+          }
+        },
+        m);
   }
   void AddRestState(const StateEstimate& s) override;
   void Finish() override;
@@ -80,6 +89,8 @@ class Smoother : public Estimator {
   void Use(const StandstillMeasurement& x, const Measurement& m);
   // A raw epoch: its pseudoranges and range rates (solver/raw_gnss_attacher.h).
   void Use(const RawGnssMeasurement& x, const Measurement& m);
+  // A measurement module's, at t (its attacher: AddModuleAttachers).
+  void UseModule(double t, const Measurement& m);
   // Offers m to every attacher; true if one asks for a solve before the next IMU sample.
   bool Attach(const Measurement& m);
   void IntegrateTo(double t, const ImuSample* held = nullptr);

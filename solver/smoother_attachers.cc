@@ -12,6 +12,7 @@
 #include "factors/gnss_velocity_factor.h"
 #include "factors/heading_factor.h"
 #include "factors/preint_attached_factor.h"
+#include "factors/module_factor.h"
 #include "factors/zero_motion_factor.h"
 #include "factors/zero_velocity_factor.h"
 #include "solver/smoother_gate.h"
@@ -387,6 +388,63 @@ void StandstillAttacher::AddStats(nlohmann::json* stats) const {
   (*stats)["zero_velocity"] = counts_.ToJson();
   (*stats)["zero_motion_factors"] = zero_motion_factors_;
   (*stats)["zero_rotation"] = zero_rotation_.ToJson();
+}
+
+// --- Measurement modules (core/measurement_module.h) ----------------------------------------------------
+
+namespace {
+
+// Module Mod's measurements: the model at the predicted state through the gate, then at its keyframe (pose,
+// velocity) or through the IMU preintegrated from it (pose, velocity, biases), with a Huber loss whose corner
+// is the gate. The module's measurements are on the IMU's clock: no time offset.
+template <class Mod>
+class ModuleAttacher final : public AttacherOf<typename Mod::Measurement> {
+ public:
+  using Model = typename Mod::Model;
+  static constexpr int kDim = Model::kResidualDim;
+
+  explicit ModuleAttacher(const typename Mod::Options& options)
+      : options_(options),
+        gate_(Chi2Gate(options.gate_probability, kDim)),
+        loss_(std::isfinite(gate_) ? new ceres::HuberLoss(std::sqrt(gate_)) : nullptr) {}
+
+  bool On(const typename Mod::Measurement& m, const AttachContext& ctx) override {
+    const Prediction pred = ctx.predict(m.t);
+    const StateBlocks at(pred.x, ctx.keyframes);
+    const Model model = Mod::ModelOf(m, options_);
+    const FactorCheck check = StampCheck(ModuleFactorAtKeyframe(model), at, true, pred, ctx).Run();
+    if (!check.Passes(gate_)) {
+      counts_.Reject(check.evaluated ? "chi2_gate" : "numerical", m.t);
+      return false;
+    }
+    const Anchor a = ctx.anchor(m.t);
+    if (a.partial == nullptr) {
+      ctx.keyframes.AddFactor(ModuleFactorAtKeyframe(model), loss_.get(),
+                              {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}});
+    } else {
+      ctx.keyframes.AddFactor(ModuleFactorPreint(a.partial, ctx.EarthTermsAt(pred.x.p_wb), model), loss_.get(),
+                              {{a.kf, BlockType::kPose}, {a.kf, BlockType::kVelocity}, {a.kf, BlockType::kBias}});
+    }
+    ++counts_.used;
+    return true;
+  }
+  void AddStats(nlohmann::json* stats) const override { (*stats)[Mod::kName] = counts_.ToJson(); }
+
+ private:
+  typename Mod::Options options_;
+  double gate_;
+  std::unique_ptr<ceres::LossFunction> loss_;
+  MeasurementCounts counts_;
+};
+
+}  // namespace
+
+void AddModuleAttachers(const SensorOptions& sensors, std::vector<std::unique_ptr<MeasurementAttacher>>* attachers) {
+  MeasurementModules::ForEach([&](auto tag) {
+    using Mod = typename decltype(tag)::type;
+    constexpr size_t i = MeasurementModules::IndexOf<Mod>();
+    attachers->push_back(std::make_unique<ModuleAttacher<Mod>>(std::get<i>(sensors.modules)));
+  });
 }
 
 }  // namespace gins

@@ -20,6 +20,7 @@
 //   standstill (checked against the predicted velocity, not above standstill.max_speed_m_s), and a
 //   zero-motion factor (no translation, 0.1 mm; no rotation, the gyro noise over the interval) between
 //   consecutive such keyframes, which with the IMU factor observes the gyro bias.
+// - each measurement module's (AddModuleAttachers).
 // The vehicle's own constraints and the wheels are solver/vehicle_attacher.h's.
 #pragma once
 
@@ -196,5 +197,9 @@ class StandstillAttacher final : public AttacherOf<StandstillMeasurement> {
   uint64_t zero_motion_factors_ = 0;
   MeasurementCounts zero_rotation_;  // the zero-motion factors' rotation part: held, or turning (not held)
 };
+
+// One attacher per measurement module (core/measurement_module.h), appended to attachers: the module's model
+// of the state at its time, gated against the window's prediction, at full weight inside the gate.
+void AddModuleAttachers(const SensorOptions& sensors, std::vector<std::unique_ptr<MeasurementAttacher>>* attachers);
 
 }  // namespace gins

@@ -25,6 +25,8 @@ double Record::t() const {
       return gnss.t;
     case Type::kGnssVelocity:
       return gnss_velocity.t;
+    case Type::kOther:
+      return other.values.empty() ? 0.0 : other.values[0];
   }
   return imu.t;
 }

@@ -1,5 +1,6 @@
 #include "apps/api/convert.h"
 
+#include <string>
 #include <variant>
 
 namespace gins::api {
@@ -40,6 +41,39 @@ void ToRecord(const GnssVelocityRecord& g, Record* out) {
   Copy(g.sigma_enu, out->gnss_velocity.sigma_enu);
 }
 
+// A measurement module's record (core/measurement_module.h): its token and numbers.
+template <typename R>
+void ToRecord(const R& m, Record* out) {
+  out->type = Record::Type::kOther;
+  out->other.type = RecordTraits<R>::kInfo.token;
+  double v[RecordTraits<R>::kInfo.max_fields];
+  out->other.values.assign(v, v + R::Values(m, v));
+}
+
+// The module record of r's token, filled from its numbers; false if no module has that token.
+template <size_t I = 0>
+bool FromOther(const OtherRecord& r, LogRecord* out) {
+  if constexpr (I == kNumRecordTypes) {
+    return false;
+  } else {
+    using R = std::variant_alternative_t<I, LogRecordData>;
+    if constexpr (MeasurementModules::kHasRecord<R>) {
+      const RecordTypeInfo& info = RecordTraits<R>::kInfo;
+      if (r.type == info.token) {
+        const size_t n = r.values.size();
+        if (n != info.min_fields && n != info.max_fields) {
+          throw Error(Error::Kind::kInput, "a " + r.type + " record has " + std::to_string(n) + " values, needs " +
+                                               std::to_string(info.min_fields) + " or " +
+                                               std::to_string(info.max_fields) + " (the time first)");
+        }
+        R::Fill(r.values.data(), n, &out->data.emplace<R>());
+        return true;
+      }
+    }
+    return FromOther<I + 1>(r, out);
+  }
+}
+
 }  // namespace
 
 LogRecord ToLogRecord(const Imu& m) { return {ImuSample{m.t, V(m.gyro), V(m.acc)}}; }
@@ -68,6 +102,9 @@ LogRecord ToLogRecord(const Record& r) {
       break;
     case Record::Type::kGnssVelocity:
       out = ToLogRecord(r.gnss_velocity);
+      break;
+    case Record::Type::kOther:
+      if (!FromOther(r.other, &out)) throw Error(Error::Kind::kInput, "unknown record type '" + r.other.type + "'");
       break;
   }
   out.line = r.line;

@@ -138,6 +138,7 @@ py::dict ReadLog(const std::filesystem::path& path, const api::Config& config) {
   std::vector<double> imu_t, gyro, acc, wheel_t, left, right, gnss_t, lat, lon, alt, heading, heading_valid, gnss_sigma,
       gvel_t, gvel_v, gvel_sigma;
   std::vector<uint64_t> imu_line, wheel_line, gnss_line, gvel_line;
+  std::map<std::string, std::pair<std::vector<std::vector<double>>, std::vector<uint64_t>>> others;
   api::ReadCounts counts;
   {
     py::gil_scoped_release release;
@@ -177,6 +178,12 @@ py::dict ReadLog(const std::filesystem::path& path, const api::Config& config) {
           gvel_line.push_back(r.line);
           break;
         }
+        case api::Record::Type::kOther: {  // a measurement module's (BARO): by token, its numbers (t first)
+          auto& [values, lines] = others[r.other.type];
+          values.push_back(r.other.values);
+          lines.push_back(r.line);
+          break;
+        }
       }
     }
     counts = reader.counts();
@@ -198,6 +205,11 @@ py::dict ReadLog(const std::filesystem::path& path, const api::Config& config) {
   log["gnss_velocity"] =
       py::dict("t"_a = ToNumpy(std::move(gvel_t), {nv}), "v_enu"_a = ToNumpy(std::move(gvel_v), {nv, 3}),
                "sigma_enu"_a = ToNumpy(std::move(gvel_sigma), {nv, 3}), "line"_a = ToNumpy(std::move(gvel_line), {nv}));
+  for (auto& [type, rows] : others) {  // "BARO": {"values": [[t, ...], ...], "line": [...]}
+    py::list values;
+    for (const std::vector<double>& v : rows.first) values.append(py::cast(v));
+    log[py::str(type)] = py::dict("values"_a = values, "line"_a = py::cast(rows.second));
+  }
   log["counts"] =
       py::dict("lines"_a = counts.lines, "imu"_a = counts.imu, "wheel"_a = counts.wheel, "gnss"_a = counts.gnss,
                "gnss_velocity"_a = counts.gnss_velocity, "skipped"_a = counts.skipped);

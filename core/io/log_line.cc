@@ -42,14 +42,16 @@ constexpr size_t MaxNumbers() {
 constexpr size_t kMaxNumbers = MaxNumbers();
 constexpr size_t kMaxTokens = kMaxNumbers + 1;  // plus the type
 
-// CheckFieldCount's messages call the optional fields the σ, "all three or none".
-constexpr bool OptionalFieldsAreThreeSigma() {
+// CheckFieldCount's messages call the optional fields the σ, "all three or none" (one alone cannot be partly
+// there).
+constexpr bool OptionalFieldsAreSigma() {
   for (const RecordTypeInfo& type : kRecordTypes) {
-    if (type.max_fields != type.min_fields && type.max_fields != type.min_fields + 3) return false;
+    const size_t optional = type.max_fields - type.min_fields;
+    if (optional != 0 && optional != 1 && optional != 3) return false;
   }
   return true;
 }
-static_assert(OptionalFieldsAreThreeSigma());
+static_assert(OptionalFieldsAreSigma());
 
 inline bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
@@ -104,8 +106,14 @@ double NormaliseHeading(double h) {
 // A record type's own part of the line: Absurd, the range checks on its n parsed numbers v (the detail of
 // the first absurd field, or empty); Fill, the record from them; Values, the inverse of Fill (the numbers in
 // log field order; returns n).
+// One specialisation per built-in alternative of LogRecordData; a measurement module's record carries its own
+// (core/measurement_module.h).
 template <typename R>
-struct FieldCodec;  // one specialisation per alternative of LogRecordData
+struct FieldCodec {
+  static std::string Absurd(const double* v, size_t n, const ImuRange& /*range*/) { return R::Absurd(v, n); }
+  static void Fill(const double* v, size_t n, R* m) { R::Fill(v, n, m); }
+  static size_t Values(const R& m, double* v) { return R::Values(m, v); }
+};
 
 template <>
 struct FieldCodec<ImuSample> {

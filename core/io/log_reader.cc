@@ -221,8 +221,9 @@ bool LogReader::Next(LogRecord* record) { return impl_->Next(record); }
 std::string FormatRecordCounts(const RecordCounts& counts, ZeroCounts zeros) {
   std::string out;
   for (size_t k = 0; k < kNumRecordTypes; ++k) {
-    const bool hidden =
-        zeros == ZeroCounts::kHide || (zeros == ZeroCounts::kHideQuiet && kRecordTypes[k].quiet_when_none);
+    const bool module = k >= kNumRecordTypes - MeasurementModules::kSize;
+    const bool hidden = zeros == ZeroCounts::kHide || module ||
+                        (zeros == ZeroCounts::kHideQuiet && kRecordTypes[k].quiet_when_none);
     if (counts[k] == 0 && hidden) continue;
     out += (out.empty() ? "" : ", ") + std::to_string(counts[k]) + " " + kRecordTypes[k].token;
   }

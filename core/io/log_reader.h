@@ -89,8 +89,9 @@ struct InputIssue {
 std::string FormatIssueCounts(const char* kind, const std::map<std::string, uint64_t>& counts,
                               const std::vector<InputIssue>& issues);
 
-// "12 IMU, 3 ODOM, 2 GNSS, 0 GVEL" in the types' order; which zero counts it leaves out: none, all, or those
-// of the types a log may well lack (RecordTypeInfo::quiet_when_none).
+// "12 IMU, 3 ODOM, 2 GNSS, 0 GVEL" in the types' order; which zero counts it leaves out: none of the built-in
+// types' (a measurement module's zero is always left out), all, or those of the types a log may well lack
+// (RecordTypeInfo::quiet_when_none).
 enum class ZeroCounts { kShow, kHide, kHideQuiet };
 std::string FormatRecordCounts(const RecordCounts& counts, ZeroCounts zeros);
 

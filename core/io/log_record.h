@@ -1,8 +1,9 @@
 // A record of the log (docs/formats.md §3), the one record type below the public API: what the reader yields,
 // what the simulator generates (core/sim/simulator.h: SimRecord, with its truth), what the writer writes and
 // what the solver's EstimatorPipeline takes (EstimatorPipeline::Add). Its types are listed once, in
-// LogRecordData; what the code around a type needs to know of it (token, names, field counts) is its
-// RecordTraits row. Per-type code (parsing, writing, dispatch) visits the variant, so a type left out is a
+// LogRecordData (a measurement module's, in core/measurement_modules.h); what the code around a type needs
+// to know of it (token, names, field counts: RecordTypeInfo, core/measurement_module.h) is its RecordTraits
+// row. Per-type code (parsing, writing, dispatch) visits the variant, so a type left out is a
 // compile error; the time stamp and the counts by type need no per-type code at all.
 #pragma once
 
@@ -13,27 +14,21 @@
 #include <type_traits>
 #include <variant>
 
+#include "core/measurement_modules.h"
 #include "core/measurements.h"
 
 namespace gins {
 
-// The record types, in the order of every list of them (messages, ReadStats::records, the summary).
-using LogRecordData = std::variant<ImuSample, WheelRecord, GnssRecord, GnssVelocityRecord>;
+// The record types, in the order of every list of them (messages, ReadStats::records, the summary): the
+// built-in ones, then the measurement modules' (core/measurement_modules.h).
+using LogRecordData = MeasurementModules::RecordsAfter<ImuSample, WheelRecord, GnssRecord, GnssVelocityRecord>;
 inline constexpr size_t kNumRecordTypes = std::variant_size_v<LogRecordData>;
 
-// One record type's row.
-struct RecordTypeInfo {
-  const char* token;          // the log's type token, "IMU"
-  const char* name;           // the API's measurement name (api::Status::rejections), "imu"
-  const char* count_key;      // its key in summary.json's input.records, "imu"
-  const char* const* fields;  // names of the numbers after the token, in log order (for messages)
-  size_t max_fields;          // a line has all of them,
-  size_t min_fields;          // or only the first min_fields: the rest are the optional σ, all three or none
-  bool quiet_when_none;       // a count of zero is left out of messages (a log before GVEL has none)
-};
-
+// One specialisation per built-in alternative of LogRecordData; a measurement module's record carries its row.
 template <typename R>
-struct RecordTraits;  // one specialisation per alternative of LogRecordData
+struct RecordTraits {
+  static constexpr RecordTypeInfo kInfo = R::kInfo;
+};
 
 namespace record_fields {
 inline constexpr const char* kImu[] = {"t", "gx", "gy", "gz", "ax", "ay", "az"};

@@ -56,6 +56,14 @@ void AppendFields(std::string* out, const GnssVelocityRecord& v) {
   }
 }
 
+// A measurement module's record: its numbers after the time (core/measurement_module.h).
+template <typename R>
+void AppendFields(std::string* out, const R& r) {
+  double v[RecordTraits<R>::kInfo.max_fields];
+  const size_t n = R::Values(r, v);
+  for (size_t i = 1; i < n; ++i) AppendNumber(out, v[i]);
+}
+
 }  // namespace
 
 // A gzip stream deflated into the AtomicFile's stdio stream, in bounded memory.

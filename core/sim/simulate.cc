@@ -84,6 +84,16 @@ void WriteLine(const GnssVelocityRecord& g, AtomicFile* log) {
                                   g.v_enu.y(), g.v_enu.z(), g.sigma_enu.x(), g.sigma_enu.y(), g.sigma_enu.z()));
 }
 
+// A measurement module's record (core/measurement_module.h): its token and numbers, 9 decimals.
+template <typename R>
+void WriteLine(const R& r, AtomicFile* log) {
+  double v[RecordTraits<R>::kInfo.max_fields];
+  const size_t n = R::Values(r, v);
+  CheckedPrintf(log, std::fprintf(log->stream(), "%s %.6f", RecordTraits<R>::kInfo.token, v[0]));
+  for (size_t i = 1; i < n; ++i) CheckedPrintf(log, std::fprintf(log->stream(), " %.9f", v[i]));
+  CheckedPrintf(log, std::fputs("\n", log->stream()));
+}
+
 void WriteRecord(const Simulator& simulator, const SimRecord& r, AtomicFile* log, AtomicFile* truth,
                  SimulationResult* result) {
   std::visit([log](const auto& m) { WriteLine(m, log); }, r.data);

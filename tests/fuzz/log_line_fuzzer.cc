@@ -34,6 +34,15 @@ void RequireSane(const gins::GnssVelocityRecord& v) {
   Require(!v.has_sigma || (v.sigma_enu.minCoeff() > 0.0 && v.sigma_enu.allFinite()));
 }
 
+template <typename R>  // a measurement module's record: its numbers finite, and back as they were read
+void RequireSane(const R& r) {
+  double v[gins::RecordTraits<R>::kInfo.max_fields];
+  const size_t n = R::Values(r, v);
+  Require(n >= gins::RecordTraits<R>::kInfo.min_fields && n <= gins::RecordTraits<R>::kInfo.max_fields);
+  for (size_t i = 0; i < n; ++i) Require(std::isfinite(v[i]));
+  Require(R::Absurd(v, n).empty());
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -57,6 +57,10 @@ class Encoder {
     }
   }
 
+  // A measurement module's record: the stream format has no operation for it, so a seed leaves it out.
+  template <typename R>
+  void Encode(const R& /*r*/, uint8_t /*param*/) {}
+
   void Encode(const ImuSample& s, uint8_t param) {
     std::array<long, 6> d;
     bool small = true;

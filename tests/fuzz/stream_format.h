@@ -462,6 +462,16 @@ inline void PrintLine(const GnssVelocityRecord& v, char* buf, size_t size) {
   }
 }
 
+template <typename R>  // a measurement module's record: its token and numbers
+void PrintLine(const R& r, char* buf, size_t size) {
+  double v[RecordTraits<R>::kInfo.max_fields];
+  const size_t n = R::Values(r, v);
+  int at = std::snprintf(buf, size, "%s", RecordTraits<R>::kInfo.token);
+  for (size_t i = 0; i < n && at > 0 && static_cast<size_t>(at) < size; ++i) {
+    at += std::snprintf(buf + at, size - at, " %.17g", v[i]);
+  }
+}
+
 inline std::string ToLogLine(const LogRecord& r) {
   char buf[320];
   std::visit([&buf](const auto& m) { PrintLine(m, buf, sizeof(buf)); }, r.data);

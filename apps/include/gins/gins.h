@@ -88,15 +88,23 @@ struct GnssVelocity {  // GVEL record
   double sigma_enu[3] = {0, 0, 0};  // m/s
 };
 
+// A record of a type this header has no struct for (a measurement module's, e.g. BARO: docs/formats.md §3),
+// as its log line has it: the type token and the numbers after it, the time first.
+struct OtherRecord {
+  std::string type;            // "BARO"
+  std::vector<double> values;  // t, then the fields
+};
+
 // Any of them: what a LogReader yields and Session::Push takes.
 struct Record {
-  enum class Type { kImu, kWheel, kGnss, kGnssVelocity };
+  enum class Type { kImu, kWheel, kGnss, kGnssVelocity, kOther };
   Type type = Type::kImu;
   uint64_t line = 0;  // the line in the log (LogReader); 0 for records made in code
   Imu imu;            // the member that type names is the one that counts
   Wheel wheel;
   Gnss gnss;
   GnssVelocity gnss_velocity;
+  OtherRecord other;
   double t() const;
 };
 

@@ -2,6 +2,8 @@
 // time-correlated GNSS position noise, and their config keys.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -49,6 +51,12 @@ bool SameFields(const GnssRecord& a, const GnssRecord& b) {
          a.heading_valid == b.heading_valid;
 }
 bool SameFields(const GnssVelocityRecord& a, const GnssVelocityRecord& b) { return a.v_enu == b.v_enu; }
+template <typename R>  // a measurement module's record: its numbers
+bool SameFields(const R& a, const R& b) {
+  double va[RecordTraits<R>::kInfo.max_fields], vb[RecordTraits<R>::kInfo.max_fields];
+  const size_t n = R::Values(a, va);
+  return n == R::Values(b, vb) && std::equal(va, va + n, vb);
+}
 
 // Bit for bit, whatever the type.
 bool SameRecord(const SimRecord& a, const SimRecord& b) {

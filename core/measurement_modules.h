@@ -5,8 +5,10 @@
 
 #include "core/measurement_module.h"
 
+#include "core/barometer.h"
+
 namespace gins {
 
-using MeasurementModules = ModuleList<>;
+using MeasurementModules = ModuleList<BarometerModule>;
 
 }  // namespace gins

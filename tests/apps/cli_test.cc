@@ -252,6 +252,40 @@ TEST_F(CliRun, RunSmoother) {
 
 // A reused --out folder shows the newest run alone: an eskf run after an `all` run leaves no smoother, batch
 // or RTS file behind for `gins eval` to score beside it. The summary's paths are absolute, given relative
+// A measurement module's records (BARO: docs/formats.md §3.6) in a log: read, counted, used by both
+// estimators; a damaged one is skipped and named like any other record's.
+TEST_F(CliRun, BarometerRecordsAreReadCountedAndUsed) {
+  ASSERT_EQ(sim_exit_, 0);
+  std::istringstream in(test::ReadFile(log_));
+  std::string text, line;
+  size_t baro = 0, damaged_line = 0, n = 0;
+  while (std::getline(in, line)) {
+    text += line + "\n";
+    ++n;
+    std::istringstream fields(line);
+    std::string type, t, lat, lon, alt;
+    if (!(fields >> type >> t >> lat >> lon >> alt) || type != "GNSS") continue;
+    text += "BARO " + t + " " + alt + " 0.5\n";  // the fix's own height: consistent, if noisy
+    ++n, ++baro;
+    if (baro == 20) {
+      text += "BARO " + t + " 2e5\n";
+      damaged_line = ++n;
+    }
+  }
+  ASSERT_GT(baro, 30u);
+  const std::string log = dir_ + "/log_baro.txt", out = dir_ + "/out_baro";
+  test::WriteFile(log, text);
+  ASSERT_EQ(RunCliInChild({"run", "--config", config_, "--log", log, "--out", out, "--mode", "both"}), 0);
+  const nlohmann::json s = Summary(out);
+  EXPECT_EQ(s["input"]["records"]["baro"].get<size_t>(), baro);
+  EXPECT_EQ(s["input"]["skipped"].value("absurd_value", 0u), 1u) << s["input"].dump();
+  EXPECT_EQ(s["input"]["skipped_lines"]["absurd_value"], nlohmann::json::array({damaged_line}));
+  for (const char* estimator : {"eskf", "smoother"}) {
+    const nlohmann::json& b = s["estimators"][estimator]["barometer"];
+    EXPECT_GT(b["used"].get<size_t>(), baro / 2) << estimator << " " << b.dump();
+  }
+}
+
 // (its readers may start from any folder).
 TEST_F(CliRun, AReusedOutFolderHoldsTheNewestRunAloneWithAbsolutePaths) {
   ASSERT_EQ(sim_exit_, 0);
@@ -935,7 +969,7 @@ TEST_F(CliRun, DamagedInputIsRefusedOrSkippedAndNamed) {
       {"inf", with(field(6, "-inf"), false), "non_finite", line},
       {"out_of_order", with(field(1, "1700000001.0"), true), "out_of_order", line},
       {"duplicate", with(good[mid], true), "duplicate", line + 1},
-      {"unknown_type", with("BARO " + f[1] + " 1013.2", true), "unknown_type", line},
+      {"unknown_type", with("MAGN " + f[1] + " 1013.2", true), "unknown_type", line},
       {"missing_fields", with("IMU " + f[1] + " 0.1 0.2", false), "missing_fields", line},
       {"extra_fields", with(good[mid] + " 7", false), "extra_fields", line},
       {"absurd_value", with(field(2, "400"), false), "absurd_value", line},

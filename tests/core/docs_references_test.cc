@@ -275,7 +275,7 @@ std::string FormatsBlock(const std::string& marker) {
 
 TEST(DocsReferences, FormatsExampleLogReadsWithoutDamage) {
   const std::string block = FormatsBlock("read by tests/core/docs_references_test.cc with gins's log reader");
-  ASSERT_FALSE(block.empty()) << "docs/formats.md §3.8: the example log or its marker is missing";
+  ASSERT_FALSE(block.empty()) << "docs/formats.md §3.9: the example log or its marker is missing";
   const std::string path = test::MakeTempDir("docs_formats") + "/log.txt";
   test::WriteFile(path, block);
   InputOptions options;
@@ -289,7 +289,7 @@ TEST(DocsReferences, FormatsExampleLogReadsWithoutDamage) {
   EXPECT_EQ(CountOf<WheelRecord>(reader.stats().records), 2u);
   EXPECT_EQ(CountOf<GnssRecord>(reader.stats().records), 2u);
   EXPECT_EQ(CountOf<GnssVelocityRecord>(reader.stats().records), 1u);
-  // §3.8: the first fix's heading with gnss.mount_yaw_deg 12.06 is a vehicle facing north-east (§2.4).
+  // §3.9: the first fix's heading with gnss.mount_yaw_deg 12.06 is a vehicle facing north-east (§2.4).
   const auto first_fix = std::find_if(records.begin(), records.end(),
                                       [](const LogRecord& x) { return x.is<GnssRecord>(); });
   ASSERT_NE(first_fix, records.end());

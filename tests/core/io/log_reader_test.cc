@@ -762,5 +762,33 @@ TEST(LogReaderStatsTest, TotalSkippedSumsAllReasons) {
   EXPECT_EQ(stats.total_skipped(), 7u);
 }
 
+// A measurement module's record (core/barometer.h) is read, range-checked and counted like any other, by its
+// own codec and row: its optional σ, its field counts and its absurd values by name.
+TEST(LogReaderParseLogLineTest, AModulesRecordLikeAnyOther) {
+  using Baro = BarometerModule::Record;
+  LogRecord record;
+  InputIssue issue;
+  ASSERT_EQ(ParseLogLine("BARO 5 12.5", &record, &issue), LineParse::kRecord);
+  ASSERT_TRUE(record.is<Baro>());
+  EXPECT_EQ(record.t(), 5.0);
+  EXPECT_EQ(record.get<Baro>().alt_m, 12.5);
+  EXPECT_EQ(record.get<Baro>().sigma_m, 0.0);
+  EXPECT_STREQ(record.info().count_key, "baro");
+  ASSERT_EQ(ParseLogLine("BARO 6 12.5 0.3", &record, &issue), LineParse::kRecord);
+  EXPECT_EQ(record.get<Baro>().sigma_m, 0.3);
+  ASSERT_EQ(CheckLogRecord(&record, &issue), LineParse::kRecord) << issue.detail;
+  EXPECT_EQ(ParseLogLine("BARO 5", &record, &issue), LineParse::kDamaged);
+  EXPECT_EQ(issue.reason, "missing_fields");
+  EXPECT_EQ(ParseLogLine("BARO 5 1 2 3", &record, &issue), LineParse::kDamaged);
+  EXPECT_EQ(issue.reason, "extra_fields");
+  EXPECT_EQ(ParseLogLine("BARO 5 2e5", &record, &issue), LineParse::kDamaged);
+  EXPECT_EQ(issue.reason, "absurd_value");
+  EXPECT_NE(issue.detail.find("(alt)"), std::string::npos) << issue.detail;
+  EXPECT_EQ(ParseLogLine("BARO 5 12 0", &record, &issue), LineParse::kDamaged);
+  EXPECT_NE(issue.detail.find("(sigma)"), std::string::npos) << issue.detail;
+  EXPECT_EQ(ParseLogLine("BARO 5 nan", &record, &issue), LineParse::kDamaged);
+  EXPECT_EQ(issue.reason, "non_finite");
+}
+
 }  // namespace
 }  // namespace gins

@@ -33,6 +33,8 @@ void WriteSample(LogWriter* w) {
   g.heading_valid = true;
   g.heading_deg = 170.9;
   w->Add({g});
+  w->Add({BarometerModule::Record{357000.3, 23.125, 0.0}});  // a measurement module's, by its own codec
+  w->Add({BarometerModule::Record{357000.4, -7.5, 0.25}});
 }
 
 TEST(LogWriterTest, RecordsReadBackExactlyPlainAndGzip) {
@@ -43,7 +45,7 @@ TEST(LogWriterTest, RecordsReadBackExactlyPlainAndGzip) {
     LogWriter w(path);
     WriteSample(&w);
     w.Commit();
-    EXPECT_EQ(w.records(), 3u);
+    EXPECT_EQ(w.records(), 5u);
     InputOptions stop;
     stop.on_error = InputErrorPolicy::kStop;
     LogReader r(path, stop);
@@ -61,6 +63,13 @@ TEST(LogWriterTest, RecordsReadBackExactlyPlainAndGzip) {
     EXPECT_TRUE(rec.get<GnssRecord>().heading_valid);
     EXPECT_EQ(rec.get<GnssRecord>().heading_deg, 170.9);
     EXPECT_FALSE(rec.get<GnssRecord>().has_sigma);
+    ASSERT_TRUE(r.Next(&rec));
+    EXPECT_EQ(rec.get<BarometerModule::Record>().alt_m, 23.125);
+    EXPECT_EQ(rec.get<BarometerModule::Record>().sigma_m, 0.0);
+    ASSERT_TRUE(r.Next(&rec));
+    EXPECT_EQ(rec.get<BarometerModule::Record>().t, 357000.4);
+    EXPECT_EQ(rec.get<BarometerModule::Record>().alt_m, -7.5);
+    EXPECT_EQ(rec.get<BarometerModule::Record>().sigma_m, 0.25);
     EXPECT_FALSE(r.Next(&rec));
   }
   EXPECT_EQ(test::ReadFile(dir + "/log.txt").rfind("# made by a test second line\nIMU 357000.0025 0.1 ", 0), 0u);

@@ -27,6 +27,7 @@
 #pragma once
 
 #include <cstddef>
+#include <initializer_list>
 #include <tuple>
 #include <type_traits>
 #include <variant>
@@ -76,27 +77,29 @@ struct ModuleList {
   // The index in the list of module M, and of the module whose measurement (or record) type is M.
   template <typename M>
   static constexpr size_t IndexOf() {
-    constexpr bool same[] = {false, std::is_same_v<M, Mod>...};
-    size_t i = 1;
-    while (i <= kSize && !same[i]) ++i;
-    return i - 1;
+    return FirstTrue({std::is_same_v<M, Mod>...});
   }
   template <typename M>
   static constexpr size_t IndexOfMeasurement() {
-    constexpr bool same[] = {false, std::is_same_v<M, typename Mod::Measurement>...};
-    size_t i = 1;
-    while (i <= kSize && !same[i]) ++i;
-    return i - 1;
+    return FirstTrue({std::is_same_v<M, typename Mod::Measurement>...});
   }
   template <typename R>
   static constexpr size_t IndexOfRecord() {
-    constexpr bool same[] = {false, std::is_same_v<R, typename Mod::Record>...};
-    size_t i = 1;
-    while (i <= kSize && !same[i]) ++i;
-    return i - 1;
+    return FirstTrue({std::is_same_v<R, typename Mod::Record>...});
   }
   template <size_t I>
   using At = std::tuple_element_t<I, std::tuple<Mod...>>;
+
+ private:
+  // The first index whose flag is set (kSize if none).
+  static constexpr size_t FirstTrue(std::initializer_list<bool> flags) {
+    size_t i = 0;
+    for (const bool f : flags) {
+      if (f) return i;
+      ++i;
+    }
+    return kSize;
+  }
 };
 
 }  // namespace gins

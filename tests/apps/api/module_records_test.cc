@@ -62,26 +62,25 @@ TEST(ApiModuleRecords, PushedAndUsedByBothEstimators) {
   }
 }
 
+// Pushing r throws an Error of kind kInput whose message holds `text`.
+void ExpectInputError(Session* session, const Record& r, const std::string& text) {
+  try {
+    session->Push(r);
+    ADD_FAILURE() << "no error for " << r.other.type;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::kInput);
+    EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+  }
+}
+
 TEST(ApiModuleRecords, UnknownTokenOrCountIsAnInputError) {
   Session session(Config(), Mode::kEskf);
   Record r;
   r.type = Record::Type::kOther;
   r.other = {"MAGN", {1.0, 2.0}};
-  try {
-    session.Push(r);
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), Error::Kind::kInput);
-    EXPECT_NE(std::string(e.what()).find("'MAGN'"), std::string::npos) << e.what();
-  }
+  ExpectInputError(&session, r, "'MAGN'");
   r.other = {"BARO", {1.0, 2.0, 3.0, 4.0}};
-  try {
-    session.Push(r);
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), Error::Kind::kInput);
-    EXPECT_NE(std::string(e.what()).find("BARO record has 4 values, needs 2 or 3"), std::string::npos) << e.what();
-  }
+  ExpectInputError(&session, r, "BARO record has 4 values, needs 2 or 3");
 }
 
 }  // namespace GINS_TEST_FILE

@@ -296,7 +296,7 @@ class PySession {
 struct Entry {
   double t;
   uint64_t line;
-  uint8_t type;  // 0 IMU, 1 wheel, 2 GNSS, 3 GNSS velocity
+  uint8_t type;  // 0 IMU, 1 wheel, 2 GNSS, 3 GNSS velocity, 4 a measurement module's
   py::ssize_t i;
 };
 
@@ -375,7 +375,34 @@ uint64_t PySession::PushRecords(const py::object& log) {
       }
     }
   }
-  bool by_line = true;
+  // A measurement module's records: read_log's entries under their token ("BARO": {"values", "line"}),
+  // made into the API's OtherRecord while the GIL is held.
+  std::vector<api::Record> others;
+  bool others_by_line = true;
+  for (const py::handle key : log.attr("keys")()) {
+    if (!py::isinstance<py::str>(key)) continue;
+    const std::string token = py::cast<std::string>(key);
+    const bool is_token = !token.empty() && std::all_of(token.begin(), token.end(), [](char c) {
+      return (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+    });
+    if (!is_token) continue;
+    const py::object part = log.attr("__getitem__")(key);
+    const py::object values = Get(part, "values"), line = Get(part, "line");
+    if (values.is_none()) throw py::key_error(token + " records without 'values'");
+    const auto rows = py::cast<std::vector<std::vector<double>>>(values);
+    std::vector<uint64_t> row_lines;
+    if (!line.is_none()) row_lines = py::cast<std::vector<uint64_t>>(line);
+    if (!line.is_none() && row_lines.size() != rows.size()) throw py::value_error(token + " line: one per record");
+    others_by_line = others_by_line && (rows.empty() || !line.is_none());
+    for (size_t i = 0; i < rows.size(); ++i) {
+      api::Record r;
+      r.type = api::Record::Type::kOther;
+      r.other = {token, rows[i]};
+      r.line = row_lines.empty() ? 0 : row_lines[i];
+      others.push_back(std::move(r));
+    }
+  }
+  bool by_line = others_by_line;
   for (int k = 0; k < 4; ++k) by_line = by_line && (n[k] == 0 || lines[k].has_value());
   const Column* times[4] = {&imu[0], &wheel[0], &gnss.t, &gnss_velocity.t};
 
@@ -385,12 +412,15 @@ uint64_t PySession::PushRecords(const py::object& log) {
   {
     py::gil_scoped_release release;
     std::vector<Entry> order;
-    order.reserve(static_cast<size_t>(n[0] + n[1] + n[2] + n[3]));
+    order.reserve(static_cast<size_t>(n[0] + n[1] + n[2] + n[3]) + others.size());
     for (int k = 0; k < 4; ++k) {
       const uint64_t* l = lines[k] ? lines[k]->data() : nullptr;
       for (py::ssize_t i = 0; i < n[k]; ++i) {
         order.push_back({(*times[k])[i], l ? l[i] : 0, static_cast<uint8_t>(k), i});
       }
+    }
+    for (size_t i = 0; i < others.size(); ++i) {
+      order.push_back({others[i].t(), others[i].line, 4, static_cast<py::ssize_t>(i)});
     }
     std::stable_sort(order.begin(), order.end(), [by_line](const Entry& a, const Entry& b) {
       if (by_line) return a.line < b.line;
@@ -412,6 +442,9 @@ uint64_t PySession::PushRecords(const py::object& log) {
           break;
         case 3:
           ok = session_->Push(gnss_velocity.Make(e.i));
+          break;
+        case 4:
+          ok = session_->Push(others[static_cast<size_t>(e.i)]);
           break;
       }
       taken += ok ? 1 : 0;

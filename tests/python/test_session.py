@@ -51,6 +51,30 @@ def test_push_records_from_numpy_gives_the_states_of_gins_run_again(log, py_all)
     assert status.origin == pytest.approx(tuple(py_all[0].summary["origin_lla"]), abs=1e-12)
 
 
+def test_a_modules_records_read_and_pushed_give_the_states_of_gins_run_again(tmp_path):
+    """A log with barometer records (a measurement module's: read_log gives them under their token, with
+    each record's numbers and line); push_records takes them with the rest, in the file's order."""
+    with gzip.open(LOG, "rt") as f:
+        lines = f.read().splitlines()
+    with_baro = []
+    for line in lines:
+        with_baro.append(line)
+        fields = line.split()
+        if fields and fields[0] == "GNSS":
+            with_baro.append(f"BARO {fields[1]} {fields[4]} 0.5")
+    path = tmp_path / "log_baro.txt"
+    path.write_text("\n".join(with_baro) + "\n")
+    log = gins.read_log(path)
+    assert len(log["BARO"]["values"]) == 166 and log["BARO"]["values"][0][2] == 0.5
+    assert log["BARO"]["line"][0] == log["gnss"]["line"][0] + 1
+    session = gins.Session(CONFIG, "eskf", max_queued_states=BIG_QUEUE)
+    assert session.push_records(log) == 18001 + 1800 + 166 + 166
+    session.finish()
+    run = gins.run(CONFIG, path, mode="eskf")
+    assert_same_states(session.poll(), run, ("eskf",))
+    assert run.summary["estimators"]["eskf"]["barometer"]["used"] > 100
+
+
 def test_vectorised_pushes_of_each_sensor_in_chunks_give_the_same_states(log, py_all):
     """push_imu / push_wheel / push_gnss with numpy slices, 50 ms of each sensor at a time: the reorder
     window (0.1 s) puts them in time order, equal stamps in the order pushed, as in the file."""

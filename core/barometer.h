@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <iterator>
 #include <optional>
 #include <string>
@@ -41,13 +42,16 @@ struct BarometerModule {
     static constexpr double kMinAlt = -1000.0, kMaxAlt = 1e5, kMaxSigma = 1e4;  // m, exclusive: as a GNSS fix's
 
     static std::string Absurd(const double* v, size_t n) {
-      if (!(v[1] > kMinAlt && v[1] < kMaxAlt)) {
-        return "field 3 (alt) " + std::to_string(v[1]) + " m, outside (-1000, 100000)";
-      }
+      if (!(v[1] > kMinAlt && v[1] < kMaxAlt)) return "field 3 (alt) " + Num(v[1]) + " m, outside (-1000, 1e+05)";
       if (n == 3 && !(v[2] > 0.0 && v[2] < kMaxSigma)) {
-        return "field 4 (sigma) " + std::to_string(v[2]) + " m, σ must be in (0, 10000)";
+        return "field 4 (sigma) " + Num(v[2]) + " m, σ must be in (0, 1e+04)";
       }
       return {};
+    }
+    static std::string Num(double v) {  // as the reader's messages write numbers
+      char text[32];
+      std::snprintf(text, sizeof(text), "%g", v);
+      return text;
     }
     static void Fill(const double* v, size_t n, Record* r) {
       r->t = v[0];

@@ -260,8 +260,7 @@ inline constexpr auto kOptionsKeys = [](auto& v, Options& o) {
   v.Section("gravity", o.sensors.gravity, kGravityKeys);
   MeasurementModules::ForEach([&](auto tag) {  // each measurement module's section (core/measurement_modules.h)
     using Mod = typename decltype(tag)::type;
-    constexpr size_t i = MeasurementModules::IndexOf<Mod>();
-    v.Section(Mod::Options::kSection, std::get<i>(o.sensors.modules), Mod::Options::kKeys);
+    v.Section(Mod::Options::kSection, std::get<typename Mod::Options>(o.sensors.modules), Mod::Options::kKeys);
   });
   v.Section("init", o.init, kInitKeys);
   v.Section("eskf", o.eskf, kEskfKeys);

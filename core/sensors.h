@@ -125,7 +125,8 @@ struct SensorOptions {
   WheelOptions wheel;
   VehicleOptions vehicle;
   GravityOptions gravity;
-  MeasurementModules::Options modules;  // each measurement module's section (core/measurement_modules.h)
+  // Each measurement module's section (core/measurement_modules.h), by its type: std::get<Mod::Options>.
+  MeasurementModules::Options modules;
 };
 
 }  // namespace gins

@@ -14,8 +14,8 @@ using eskf::EmbedJacobian;
 void Eskf::SetModuleGates() {
   MeasurementModules::ForEach([&](auto tag) {
     using Mod = typename decltype(tag)::type;
-    constexpr size_t i = MeasurementModules::IndexOf<Mod>();
-    module_gates_[i] = Chi2Gate(std::get<i>(sensors_.modules).gate_probability, Mod::Model::kResidualDim);
+    module_gates_[MeasurementModules::IndexOf<Mod>()] =
+        Chi2Gate(std::get<typename Mod::Options>(sensors_.modules).gate_probability, Mod::Model::kResidualDim);
   });
 }
 
@@ -30,7 +30,7 @@ void Eskf::UseModule(const Measurement& measurement) {
           static_assert(D >= 1 && D <= 3, "a module's residual has 1 to 3 rows (Eskf::Update's sizes)");
           if (!initialized_ || m.t < nom_.x.t) return;
           Propagate(m.t);
-          const typename Mod::Model model = Mod::ModelOf(m, std::get<i>(sensors_.modules));
+          const typename Mod::Model model = Mod::ModelOf(m, std::get<typename Mod::Options>(sensors_.modules));
           const Model<D> linearized = [&] {
             Eigen::Matrix<double, D, 1> r;
             Eigen::Matrix<double, D, 9> H;  // (δp, δθ, δv)

@@ -221,7 +221,7 @@ void EstimatorPipeline::AddModuleRecord(const R& r) {
   DrainRawGnss(r.t);
   Touch(r.t);
   std::optional<typename Mod::Measurement> m;
-  if (initialized_) m = Mod::ToMeasurement(r, std::get<i>(sensors_.modules), *frame_);
+  if (initialized_) m = Mod::ToMeasurement(r, std::get<typename Mod::Options>(sensors_.modules), *frame_);
   if (!m) {
     ++module_unused_[i];
     return;

@@ -442,8 +442,7 @@ class ModuleAttacher final : public AttacherOf<typename Mod::Measurement> {
 void AddModuleAttachers(const SensorOptions& sensors, std::vector<std::unique_ptr<MeasurementAttacher>>* attachers) {
   MeasurementModules::ForEach([&](auto tag) {
     using Mod = typename decltype(tag)::type;
-    constexpr size_t i = MeasurementModules::IndexOf<Mod>();
-    attachers->push_back(std::make_unique<ModuleAttacher<Mod>>(std::get<i>(sensors.modules)));
+    attachers->push_back(std::make_unique<ModuleAttacher<Mod>>(std::get<typename Mod::Options>(sensors.modules)));
   });
 }
 
